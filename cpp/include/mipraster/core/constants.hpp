@@ -1,0 +1,45 @@
+#pragma once
+// Every numeric constant of the pipeline, each with why it has its value and a check of its bound.
+#include <cstdint>
+
+namespace mipraster {
+
+/// Sub-pixel precision of snapped vertex and sample positions: 16.8 fixed point (1/256 px).
+inline constexpr int kSubpixelBits = 8;
+inline constexpr std::int64_t kSubpixelOne = std::int64_t{1} << kSubpixelBits;
+
+/// Largest framebuffer width or height. Bounds sample coordinates in fixed point.
+inline constexpr int kMaxDimension = 32768;
+
+/// Guard band: screen coordinates may lie this far (in pixels) from the viewport centre before
+/// the sides are clipped; inside it, triangles are rasterized unclipped.
+inline constexpr double kGuardBandPx = double(1 << 20);
+
+/// Largest magnitude of a snapped coordinate (1/256 px units): guard band plus half the viewport.
+inline constexpr std::int64_t kMaxFixedCoordinate =
+    (std::int64_t{1 << 20} + kMaxDimension) * kSubpixelOne;
+// Edge coefficients are differences of two coordinates: they must fit int32 for the stepping loop.
+static_assert(2 * kMaxFixedCoordinate < (std::int64_t{1} << 31), "edge coefficients must fit int32");
+// An edge value is A·X + B·Y + C with |A|,|B| ≤ 2·max and |X|,|Y|,|C/(2·max)| ≤ 2·max:
+// at most 3·(2·max)² in magnitude, which must stay inside int64.
+static_assert(2 * kMaxFixedCoordinate < (std::int64_t{1} << 30), "edge values need 4·(2^30)^2 < 2^63");
+
+/// Samples per pixel: coverage of one pixel is a 64-bit mask.
+inline constexpr int kMaxSamples = 64;
+
+/// Square screen tile, in pixels: a thread rasterizes whole tiles. 32 px keeps a tile's colour
+/// and depth samples (32·32·S·20 bytes) within L2 for S up to 16.
+inline constexpr int kTileSize = 32;
+static_assert(kTileSize % 8 == 0 && kTileSize <= 256, "tile size must be a small multiple of 8");
+
+/// Refuse framebuffers larger than this (colour + depth for all samples) before allocating.
+inline constexpr std::uint64_t kMaxFramebufferBytes = std::uint64_t{16} << 30;
+
+/// Clipped vertices keep w at least this large so 1/w is finite (the near plane of a sane camera
+/// is far above it; it matters only for degenerate user matrices).
+inline constexpr double kMinClipW = 1e-30;
+
+/// Most threads a render may ask for.
+inline constexpr int kMaxThreads = 256;
+
+}  // namespace mipraster

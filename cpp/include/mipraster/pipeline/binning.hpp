@@ -1,0 +1,33 @@
+#pragma once
+// Binning stage: set-up triangles sorted into screen tiles, keeping submission order per tile.
+#include <cstdint>
+#include <vector>
+
+#include "mipraster/pipeline/triangle_setup.hpp"
+
+namespace mipraster {
+
+/// The screen split into kTileSize × kTileSize pixel tiles, row-major.
+struct TileGrid {
+    int width = 0, height = 0;  ///< viewport size in pixels
+    int tiles_x = 0, tiles_y = 0;
+
+    static TileGrid for_viewport(int width, int height);
+    int count() const { return tiles_x * tiles_y; }
+};
+
+/// One contiguous run of submitted triangles after setup, with its per-tile lists (CSR layout:
+/// the triangles touching tile i are tile_triangles[tile_start[i] … tile_start[i+1]), ascending).
+/// Processing chunks in order and each tile list in order is submission order, however the
+/// triangles were split into chunks.
+struct BinnedChunk {
+    std::vector<SetupTriangle> triangles;
+    std::vector<ClipWeights> clip_weights;
+    std::vector<std::uint32_t> tile_start;
+    std::vector<std::uint32_t> tile_triangles;
+};
+
+/// Fills chunk.tile_start / tile_triangles from chunk.triangles' pixel bounds (a counting sort).
+void bin_triangles(BinnedChunk& chunk, const TileGrid& grid);
+
+}  // namespace mipraster

@@ -1,0 +1,50 @@
+#pragma once
+// Homogeneous clipping: always against the near (and far) plane, against the sides only where a
+// triangle leaves the guard band, so that every coordinate after it fits the fixed-point range.
+#include <array>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "mipraster/scene/camera.hpp"
+
+namespace mipraster {
+
+/// A clip-space vertex and its weights of the original triangle's three vertices.
+struct ClipVertex {
+    glm::dvec4 position;
+    glm::dvec3 weights;
+};
+
+/// Inside the volume ⇔ dot(normal, p) + offset ≥ 0 for every plane.
+struct ClipPlane {
+    glm::dvec4 normal;
+    double offset = 0.0;
+    double distance(const glm::dvec4& p) const;
+};
+
+inline constexpr int kClipPlaneCount = 7;  // near, far, w > 0, and four guard-band sides
+
+struct ClipVolume {
+    std::array<ClipPlane, kClipPlaneCount> planes;
+};
+
+/// The clip volume of a viewport: depth range of `convention`, w ≥ kMinClipW, and sides at
+/// the guard band (kGuardBandPx from the viewport centre).
+ClipVolume make_clip_volume(DepthConvention convention, int width, int height);
+
+/// A clipped convex polygon: at most 3 + one vertex per plane.
+struct ClipPolygon {
+    int count = 0;
+    std::array<ClipVertex, 3 + kClipPlaneCount> vertices;
+};
+
+enum class ClipOutcome { inside, outside, clipped };
+
+/// Classifies the triangle; when it crosses a plane, fills `out` with the clipped polygon
+/// (Sutherland–Hodgman). Each crossing point is computed from its edge's endpoints in a fixed
+/// order, so a shared edge clips to bit-identical vertices from either triangle.
+ClipOutcome clip_triangle(const glm::dvec4& p0, const glm::dvec4& p1, const glm::dvec4& p2, const ClipVolume& volume,
+                          ClipPolygon& out);
+
+}  // namespace mipraster

@@ -1,0 +1,54 @@
+#pragma once
+// A draw: a mesh, its model matrix, a constant colour and the fixed-function state it uses.
+#include <string>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
+
+#include "mipraster/scene/mesh.hpp"
+
+namespace mipraster {
+
+/// How a fragment combines with the framebuffer (premultiplied linear float; nothing clamps).
+enum class BlendMode {
+    replace,  ///< dst = src
+    add,      ///< dst = dst + src
+    over,     ///< dst = src + (1 − src.a)·dst (Porter–Duff over, premultiplied)
+};
+
+/// How vertex attributes vary across a triangle.
+enum class Interpolation {
+    flat,         ///< the first vertex's value everywhere (provoking vertex)
+    screen,       ///< affine in screen space (the seeds' "perspective-incorrect" interpolation)
+    perspective,  ///< perspective-correct (interpolate a/w and 1/w, divide)
+};
+
+enum class CullMode { none, back, front };  ///< front faces are counter-clockwise in NDC (y up)
+
+std::string to_string(BlendMode mode);
+std::string to_string(Interpolation mode);
+std::string to_string(CullMode mode);
+
+/// Fixed-function state of one draw.
+struct DrawState {
+    bool depth_test = true;   ///< compare with the camera's depth convention (GREATER / LESS)
+    bool depth_write = true;  ///< store the depth of samples that pass
+    BlendMode blend = BlendMode::replace;
+    Interpolation interpolation = Interpolation::perspective;
+    CullMode cull = CullMode::none;
+
+    std::string to_string() const;
+};
+
+/// One draw call. The fragment colour is `color` × the interpolated vertex colour (when the mesh
+/// has vertex colours), premultiplied linear RGBA. The mesh must outlive the render.
+struct Draw {
+    const Mesh* mesh = nullptr;
+    glm::dmat4 model{1.0};
+    glm::vec4 color{1.0f};
+    DrawState state;
+
+    std::string to_string() const;
+};
+
+}  // namespace mipraster

@@ -1,0 +1,52 @@
+#pragma once
+// Interpolation stage: barycentric weights of a sample from its exact edge values, in screen
+// space or perspective-correct, mapped back to the original (unclipped) triangle's vertices.
+#include <algorithm>
+#include <cstdint>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "mipraster/pipeline/triangle_setup.hpp"
+
+namespace mipraster {
+
+/// Screen-space barycentrics λ from the (biased) edge values at a sample: λ_i = E_i / 2A.
+inline glm::dvec3 screen_weights(const SetupTriangle& t, std::int64_t e0, std::int64_t e1, std::int64_t e2) {
+    return glm::dvec3(static_cast<double>(e0 + t.bias[0]), static_cast<double>(e1 + t.bias[1]),
+                      static_cast<double>(e2 + t.bias[2])) * t.inv_area2;
+}
+
+/// Window depth at a sample: z0 + λ1·dz1 + λ2·dz2 (exact for a constant-depth triangle).
+inline float sample_depth(const SetupTriangle& t, const glm::dvec3& l) {
+    return static_cast<float>(t.z0 + l.y * t.dz1 + l.z * t.dz2);
+}
+
+/// Perspective-correct weights: λ_i/w_i normalized. Each is ≥ 0 inside the triangle and they
+/// sum to 1, so interpolated values stay within the vertex values (up to rounding).
+inline glm::dvec3 perspective_weights(const SetupTriangle& t, const glm::dvec3& l) {
+    const glm::dvec3 q(l.x * t.inv_w[0], l.y * t.inv_w[1], l.z * t.inv_w[2]);
+    return q / (q.x + q.y + q.z);
+}
+
+/// Maps weights of the setup triangle's vertices to weights of the original triangle's vertices
+/// (they differ only when the triangle was clipped).
+inline glm::dvec3 original_weights(const SetupTriangle& t, const glm::dvec3& w, const ClipWeights* clip_weights) {
+    if (t.clip_index < 0) return w;
+    const ClipWeights& c = clip_weights[t.clip_index];
+    return w.x * glm::dvec3(c[0]) + w.y * glm::dvec3(c[1]) + w.z * glm::dvec3(c[2]);
+}
+
+/// Σ w_i·v_i, clamped to the per-component range of the v_i so rounding never leaves it.
+inline glm::vec4 blend_vertex_values(const glm::dvec3& w, const glm::vec4& v0, const glm::vec4& v1,
+                                     const glm::vec4& v2) {
+    glm::vec4 r;
+    for (int c = 0; c < 4; ++c) {
+        const double x = w.x * v0[c] + w.y * v1[c] + w.z * v2[c];
+        const float lo = std::min({v0[c], v1[c], v2[c]}), hi = std::max({v0[c], v1[c], v2[c]});
+        r[c] = std::clamp(static_cast<float>(x), lo, hi);
+    }
+    return r;
+}
+
+}  // namespace mipraster

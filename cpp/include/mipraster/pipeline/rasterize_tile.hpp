@@ -1,0 +1,64 @@
+#pragma once
+// Tile rasterization: edge functions stepped over the samples of one screen tile, then depth
+// test, shading and blending of covered samples. Specialized at compile time on the features a
+// draw uses; select_tile_kernel picks the instance.
+#include <cstddef>
+#include <cstdint>
+
+#include <glm/vec4.hpp>
+
+#include "mipraster/pipeline/draw.hpp"
+#include "mipraster/pipeline/framebuffer.hpp"
+#include "mipraster/pipeline/sample_pattern.hpp"
+#include "mipraster/pipeline/triangle_setup.hpp"
+
+namespace mipraster {
+
+enum class DepthFunc { none, greater, less };
+/// What a fragment's colour needs: nothing but the draw colour, the provoking vertex's colour,
+/// or interpolated vertex colours (screen space or perspective-correct).
+enum class Shading { constant, flat, screen, perspective };
+/// single: one sample per pixel; ssaa: shade every sample; msaa: shade once per pixel per triangle.
+enum class SampleMode { single, ssaa, msaa };
+
+struct PipelineKey {
+    DepthFunc depth = DepthFunc::none;
+    BlendMode blend = BlendMode::replace;
+    Shading shading = Shading::constant;
+    SampleMode samples = SampleMode::single;
+};
+
+/// The pixel rectangle [x0, x1) × [y0, y1) of one tile and the framebuffer it writes.
+struct TileTarget {
+    Framebuffer* framebuffer;
+    const SamplePattern* pattern;
+    int x0, y0, x1, y1;
+};
+
+/// Per-draw inputs of the kernel.
+struct DrawInputs {
+    const glm::uvec3* triangles;
+    const glm::vec4* vertex_colors;  ///< null when the mesh has none
+    glm::vec4 color;
+    bool depth_write;
+};
+
+/// Triangles of one draw, in submission order: tris[indices[k]] for k < count.
+struct TriangleBatch {
+    const SetupTriangle* tris;
+    const std::uint32_t* indices;
+    std::size_t count;
+    const ClipWeights* clip_weights;
+};
+
+struct TileCounters {
+    std::uint64_t samples_covered = 0;  ///< samples inside a triangle
+    std::uint64_t samples_passed = 0;   ///< of those, passed the depth test
+    std::uint64_t shader_invocations = 0;
+};
+
+using TileKernel = void (*)(const TileTarget&, const DrawInputs&, const TriangleBatch&, TileCounters&);
+
+TileKernel select_tile_kernel(const PipelineKey& key);
+
+}  // namespace mipraster

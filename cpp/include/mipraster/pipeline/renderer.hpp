@@ -1,0 +1,66 @@
+#pragma once
+// The pipeline driver: vertex transform → clip → setup → bin → rasterize tiles → resolve.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "mipraster/core/image.hpp"
+#include "mipraster/pipeline/draw.hpp"
+#include "mipraster/pipeline/framebuffer.hpp"
+#include "mipraster/pipeline/resolve.hpp"
+#include "mipraster/pipeline/sample_pattern.hpp"
+#include "mipraster/scene/camera.hpp"
+
+namespace mipraster {
+
+/// SSAA shades every sample; MSAA shades once per pixel per triangle and stores the colour to
+/// the covered samples (depth is still per sample).
+enum class AntiAliasing { ssaa, msaa };
+
+std::string to_string(AntiAliasing aa);
+AntiAliasing parse_anti_aliasing(const std::string& name);
+
+struct RenderSettings {
+    int width = 0, height = 0;
+    int samples = 1;                                ///< samples per pixel, 1…64
+    PatternKind pattern = PatternKind::automatic;   ///< see make_sample_pattern
+    std::uint64_t pattern_seed = 0;                 ///< for PatternKind::stratified
+    AntiAliasing anti_aliasing = AntiAliasing::ssaa;
+    int threads = 0;                                ///< 0 = all hardware threads
+    glm::vec4 clear_color{0.0f};                    ///< premultiplied linear RGBA
+    ResolveFilter resolve_filter = ResolveFilter::box;
+    bool keep_samples = false;                      ///< return the supersample framebuffer too
+
+    std::string to_string() const;
+};
+
+/// Counts and times of one render. Counts do not depend on the thread count.
+struct RenderStats {
+    std::uint64_t triangles_in = 0;        ///< submitted triangles
+    std::uint64_t triangles_clipped = 0;   ///< crossed a clip plane and were clipped
+    std::uint64_t triangles_outside = 0;   ///< entirely outside the clip volume or the viewport
+    std::uint64_t triangles_backface = 0;  ///< removed by face culling
+    std::uint64_t triangles_degenerate = 0;///< zero area after snapping
+    std::uint64_t triangles_nonfinite = 0; ///< non-finite after transform (e.g. a degenerate matrix): dropped
+    std::uint64_t triangles_rasterized = 0;///< set-up (sub-)triangles sent to the rasterizer
+    std::uint64_t samples_covered = 0, samples_passed = 0, shader_invocations = 0;
+    int threads = 1;
+    double transform_ms = 0, setup_ms = 0, raster_ms = 0, resolve_ms = 0, total_ms = 0;
+
+    std::string to_string() const;
+};
+
+struct RenderResult {
+    Image color;              ///< (H, W, 4) linear premultiplied RGBA after resolve
+    Framebuffer framebuffer;  ///< all samples, when RenderSettings::keep_samples
+    SamplePattern pattern;
+    RenderStats stats;
+};
+
+/// Renders the draws in order. Bad input (sizes, sample counts, meshes) throws
+/// std::invalid_argument naming it, before any large allocation.
+RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const RenderSettings& settings);
+
+}  // namespace mipraster

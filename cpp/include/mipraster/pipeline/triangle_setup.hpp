@@ -1,0 +1,50 @@
+#pragma once
+// Triangle setup: project and snap to 16.8 fixed point, cull, and build the exact integer edge
+// equations (top-left rule folded in) and the depth and 1/w planes the rasterizer steps.
+#include <array>
+#include <cstdint>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "mipraster/pipeline/draw.hpp"
+#include "mipraster/scene/camera.hpp"
+
+namespace mipraster {
+
+/// A triangle ready for rasterization. Edge i is opposite vertex i; at a sample (X, Y) in
+/// 1/256 px, E_i = a_i·X + b_i·Y + c_i is exact in int64, and the sample is inside iff all three
+/// E_i ≥ 0 (c_i already includes the top-left bias; `bias_i` adds it back for barycentrics).
+struct SetupTriangle {
+    std::array<std::int32_t, 3> edge_a, edge_b;
+    std::array<std::int64_t, 3> edge_c;
+    std::array<std::int8_t, 3> bias;
+    std::int32_t min_x, min_y, max_x, max_y;  ///< inclusive pixel bounds, inside the viewport
+    double inv_area2;                         ///< 1 / (twice the area in 1/256² px²)
+    float z0, dz1, dz2;                       ///< depth = z0 + λ1·dz1 + λ2·dz2 (window depth)
+    std::array<float, 3> inv_w;               ///< 1/w at each vertex
+    std::int32_t clip_index;                  ///< −1, or which clipped-weights entry maps vertices to the original
+    std::uint32_t triangle;                   ///< index of the original triangle within its draw
+    std::uint32_t draw;                       ///< index of the draw
+};
+
+/// Weights of the original triangle's vertices at the three vertices of a clipped sub-triangle.
+using ClipWeights = std::array<glm::vec3, 3>;
+
+/// What setup rejected, by reason.
+struct SetupCounters {
+    std::uint64_t culled_backface = 0, culled_degenerate = 0, culled_outside = 0, dropped_nonfinite = 0;
+};
+
+struct Viewport {
+    int width = 0, height = 0;
+    DepthConvention depth_convention = DepthConvention::reverse_z;
+};
+
+/// Sets up the triangle with clip-space vertices p[0..2]. Returns false (and counts why) when it
+/// is culled: back/front facing per `cull`, zero area after snapping, no pixel of the viewport in
+/// its bounds, or a non-finite projected coordinate.
+bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport, CullMode cull, SetupTriangle& out,
+                    SetupCounters& counters);
+
+}  // namespace mipraster

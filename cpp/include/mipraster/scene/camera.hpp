@@ -1,0 +1,56 @@
+#pragma once
+// Camera: view and projection matrices (double precision) and the depth convention they follow.
+#include <limits>
+#include <string>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+namespace mipraster {
+
+/// How a projection maps view depth to clip z, and so which depth test and clear value apply.
+enum class DepthConvention {
+    reverse_z,  ///< near → 1, far (or infinity) → 0; clip volume 0 ≤ z ≤ w; test GREATER, clear 0
+    opengl,     ///< near → −1, far → +1; clip volume −w ≤ z ≤ w; window depth z/2+½; test LESS, clear 1
+};
+
+std::string to_string(DepthConvention convention);
+
+/// Right-handed view matrix: the camera at `eye` looks at `target` down its −z axis, +y up
+/// (the seeds' construction: rows u, v, −w with w the view direction).
+glm::dmat4 look_at(const glm::dvec3& eye, const glm::dvec3& target, const glm::dvec3& up);
+
+inline constexpr double kInfiniteFar = std::numeric_limits<double>::infinity();
+
+/// Perspective projection of the frustum (l, r, b, t) at distance n, far plane at f (may be
+/// kInfiniteFar for reverse-Z). With DepthConvention::opengl this is exactly the seeds' matrix.
+glm::dmat4 frustum(double l, double r, double b, double t, double n, double f,
+                   DepthConvention convention = DepthConvention::reverse_z);
+
+/// Perspective projection from the vertical field of view (radians) and aspect = width/height.
+glm::dmat4 perspective(double fovy, double aspect, double near, double far = kInfiniteFar,
+                       DepthConvention convention = DepthConvention::reverse_z);
+
+/// Orthographic projection of the box [l,r]×[b,t]×[−n,−f] in view space (f must be finite).
+glm::dmat4 orthographic(double l, double r, double b, double t, double n, double f,
+                        DepthConvention convention = DepthConvention::reverse_z);
+
+/// A camera: world → view → clip. The library's own constructors use reverse-Z; matrices from
+/// elsewhere (OpenGL style) are accepted with DepthConvention::opengl.
+struct Camera {
+    glm::dmat4 view{1.0};
+    glm::dmat4 projection{1.0};
+    DepthConvention depth_convention = DepthConvention::reverse_z;
+
+    /// Camera at `eye` looking at `target`, vertical field of view `fovy` (radians), reverse-Z with
+    /// an infinite far plane.
+    static Camera look_at_perspective(const glm::dvec3& eye, const glm::dvec3& target, const glm::dvec3& up,
+                                      double fovy, double aspect, double near);
+    /// Raw matrices, e.g. from an OpenGL program (column vectors: clip = projection · view · p).
+    static Camera from_matrices(const glm::dmat4& view, const glm::dmat4& projection,
+                                DepthConvention convention = DepthConvention::opengl);
+
+    std::string to_string() const;
+};
+
+}  // namespace mipraster

@@ -1,0 +1,87 @@
+#include "mipraster/core/thread_pool.hpp"
+
+#include <stdexcept>
+#include <string>
+
+#include "mipraster/core/constants.hpp"
+
+namespace mipraster {
+
+int resolve_thread_count(int requested) {
+    if (requested < 0 || requested > kMaxThreads)
+        throw std::invalid_argument("threads: expected 0 (all cores) to " + std::to_string(kMaxThreads) +
+                                    ", got " + std::to_string(requested));
+    if (requested > 0) return requested;
+    const unsigned hw = std::thread::hardware_concurrency();
+    return hw == 0 ? 1 : static_cast<int>(hw);
+}
+
+ThreadPool::ThreadPool(int threads) {
+    for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { worker_loop(); });
+}
+
+ThreadPool::~ThreadPool() {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        stop_ = true;
+    }
+    wake_.notify_all();
+    for (auto& t : workers_) t.join();
+}
+
+void ThreadPool::run_tasks(std::unique_lock<std::mutex>& lock) {
+    // Takes indices one at a time under the lock and runs each task unlocked.
+    while (next_ < count_) {
+        const std::size_t i = next_++;
+        const auto* task = task_;
+        lock.unlock();
+        std::exception_ptr failure;
+        try {
+            (*task)(i);
+        } catch (...) {
+            failure = std::current_exception();
+        }
+        lock.lock();
+        if (failure && !error_) {
+            error_ = failure;
+            next_ = count_;  // stop handing out work
+        }
+        ++finished_;
+    }
+}
+
+void ThreadPool::worker_loop() {
+    std::size_t seen = 0;
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+        wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
+        if (stop_) return;
+        seen = generation_;
+        ++busy_workers_;
+        run_tasks(lock);
+        --busy_workers_;
+        done_.notify_all();
+    }
+}
+
+void ThreadPool::parallel_for(std::size_t count, const std::function<void(std::size_t)>& task) {
+    if (count == 0) return;
+    if (workers_.empty() || count == 1) {
+        for (std::size_t i = 0; i < count; ++i) task(i);
+        return;
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    task_ = &task;
+    count_ = count;
+    next_ = 0;
+    finished_ = 0;
+    error_ = nullptr;
+    ++generation_;
+    wake_.notify_all();
+    run_tasks(lock);
+    done_.wait(lock, [&] { return finished_ == count_ && busy_workers_ == 0; });
+    task_ = nullptr;
+    if (error_) std::rethrow_exception(error_);
+}
+
+}  // namespace mipraster

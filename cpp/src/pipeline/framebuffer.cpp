@@ -1,0 +1,53 @@
+#include "mipraster/pipeline/framebuffer.hpp"
+
+#include <stdexcept>
+
+#include "mipraster/core/constants.hpp"
+
+namespace mipraster {
+
+std::uint64_t framebuffer_bytes(int width, int height, int samples, bool with_depth) {
+    const std::uint64_t n = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) *
+                            static_cast<std::uint64_t>(samples);
+    return n * (4 * sizeof(float) + (with_depth ? sizeof(float) : 0));
+}
+
+void validate_framebuffer_size(int width, int height, int samples, bool with_depth) {
+    auto dim = [](const char* name, int v) {
+        if (v < 1 || v > kMaxDimension)
+            throw std::invalid_argument(std::string(name) + ": expected 1 to " + std::to_string(kMaxDimension) +
+                                        " pixels, got " + std::to_string(v));
+    };
+    dim("width", width);
+    dim("height", height);
+    if (samples < 1 || samples > kMaxSamples)
+        throw std::invalid_argument("samples per pixel: expected 1 to " + std::to_string(kMaxSamples) + ", got " +
+                                    std::to_string(samples));
+    const std::uint64_t bytes = framebuffer_bytes(width, height, samples, with_depth);
+    if (bytes > kMaxFramebufferBytes)
+        throw std::invalid_argument("framebuffer " + std::to_string(width) + "x" + std::to_string(height) + "x" +
+                                    std::to_string(samples) + " would need " + std::to_string(bytes >> 20) +
+                                    " MiB; the limit is " + std::to_string(kMaxFramebufferBytes >> 20) + " MiB");
+}
+
+Framebuffer make_framebuffer(int width, int height, int samples, glm::vec4 clear_color, bool with_depth,
+                             float clear_depth) {
+    validate_framebuffer_size(width, height, samples, with_depth);
+    Framebuffer fb;
+    fb.width = width;
+    fb.height = height;
+    fb.samples = samples;
+    const std::size_t n = static_cast<std::size_t>(width) * height * samples;
+    fb.color.resize(4 * n);
+    for (std::size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 4; ++c) fb.color[4 * i + c] = clear_color[c];
+    if (with_depth) fb.depth.assign(n, clear_depth);
+    return fb;
+}
+
+std::string Framebuffer::to_string() const {
+    return "Framebuffer(" + std::to_string(width) + "x" + std::to_string(height) + ", samples=" +
+           std::to_string(samples) + (has_depth() ? ", depth" : ", no depth") + ")";
+}
+
+}  // namespace mipraster

@@ -1,0 +1,199 @@
+#include "mipraster/pipeline/rasterize_tile.hpp"
+
+#include <algorithm>
+
+#include "mipraster/core/constants.hpp"
+#include "mipraster/pipeline/blend.hpp"
+#include "mipraster/pipeline/interpolate.hpp"
+
+namespace mipraster {
+
+namespace {
+
+template <DepthFunc kDepth>
+inline bool depth_passes(float z, float stored) {
+    if constexpr (kDepth == DepthFunc::greater) return z > stored;
+    else if constexpr (kDepth == DepthFunc::less) return z < stored;
+    else return true;
+}
+
+// The vertex colours a draw's triangle needs, loaded once per triangle and tile.
+struct TriangleColors {
+    glm::vec4 v[3];
+};
+
+template <Shading kShading>
+inline glm::vec4 shade(const DrawInputs& draw, const TriangleColors& tc, const SetupTriangle& t,
+                       const glm::dvec3& screen, const ClipWeights* clip_weights) {
+    if constexpr (kShading == Shading::constant) {
+        return draw.color;
+    } else if constexpr (kShading == Shading::flat) {
+        return draw.color * tc.v[0];
+    } else {
+        const glm::dvec3 w = kShading == Shading::perspective ? perspective_weights(t, screen) : screen;
+        return draw.color * blend_vertex_values(original_weights(t, w, clip_weights), tc.v[0], tc.v[1], tc.v[2]);
+    }
+}
+
+template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode>
+void raster_tile(const TileTarget& target, const DrawInputs& draw, const TriangleBatch& batch,
+                 TileCounters& counters) {
+    Framebuffer& fb = *target.framebuffer;
+    const SamplePattern& pattern = *target.pattern;
+    const int S = kMode == SampleMode::single ? 1 : pattern.count();
+    constexpr std::int64_t kStep = kSubpixelOne;  // one pixel in fixed point
+
+    for (std::size_t k = 0; k < batch.count; ++k) {
+        const SetupTriangle& t = batch.tris[batch.indices[k]];
+        const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
+        const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
+        if (x0 >= x1 || y0 >= y1) continue;
+
+        TriangleColors tc{};
+        if constexpr (kShading != Shading::constant) {
+            const glm::uvec3 tri = draw.triangles[t.triangle];
+            for (int i = 0; i < 3; ++i) tc.v[i] = draw.vertex_colors ? draw.vertex_colors[tri[i]] : glm::vec4(1.0f);
+        }
+
+        // Edge offsets of each sample from its pixel's corner: a·ox + b·oy.
+        std::int64_t off0[kMaxSamples], off1[kMaxSamples], off2[kMaxSamples];
+        for (int s = 0; s < S; ++s) {
+            off0[s] = std::int64_t{t.edge_a[0]} * pattern.x[s] + std::int64_t{t.edge_b[0]} * pattern.y[s];
+            off1[s] = std::int64_t{t.edge_a[1]} * pattern.x[s] + std::int64_t{t.edge_b[1]} * pattern.y[s];
+            off2[s] = std::int64_t{t.edge_a[2]} * pattern.x[s] + std::int64_t{t.edge_b[2]} * pattern.y[s];
+        }
+        const std::int64_t step0 = t.edge_a[0] * kStep, step1 = t.edge_a[1] * kStep, step2 = t.edge_a[2] * kStep;
+
+        for (int py = y0; py < y1; ++py) {
+            // Edge values at the top-left corner of pixel (x0, py), exact in int64.
+            const std::int64_t X = std::int64_t{x0} * kStep, Y = std::int64_t{py} * kStep;
+            const std::int64_t row0 = t.edge_a[0] * X + t.edge_b[0] * Y + t.edge_c[0];
+            const std::int64_t row1 = t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1];
+            const std::int64_t row2 = t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2];
+            const int n = x1 - x0;
+
+            // Coverage masks of the row: sample s of pixel j is inside iff all three edge values are
+            // ≥ 0, i.e. the sign bit of their OR is clear. Plain integer adds: this loop vectorizes.
+            std::uint64_t mask[kTileSize];
+            std::fill(mask, mask + n, std::uint64_t{0});
+            for (int s = 0; s < S; ++s) {
+                std::int64_t e0 = row0 + off0[s], e1 = row1 + off1[s], e2 = row2 + off2[s];
+                for (int j = 0; j < n; ++j) {
+                    mask[j] |= static_cast<std::uint64_t>((e0 | e1 | e2) >= 0) << s;
+                    e0 += step0;
+                    e1 += step1;
+                    e2 += step2;
+                }
+            }
+
+            for (int j = 0; j < n; ++j) {
+                std::uint64_t covered = mask[j];
+                if (!covered) continue;
+                const int px = x0 + j;
+                const std::int64_t p0 = row0 + j * step0, p1 = row1 + j * step1, p2 = row2 + j * step2;
+                const std::size_t base = fb.sample_index(px, py, 0);
+
+                if constexpr (kMode == SampleMode::msaa) {
+                    // Depth per sample, colour once per pixel: at the pixel centre when it is inside the
+                    // triangle, else at the first covered sample that passed (never extrapolated).
+                    std::uint64_t passed = 0;
+                    for (std::uint64_t m = covered; m; m &= m - 1) {
+                        const int s = __builtin_ctzll(m);
+                        ++counters.samples_covered;
+                        if constexpr (kDepth != DepthFunc::none) {
+                            const float z = sample_depth(t, screen_weights(t, p0 + off0[s], p1 + off1[s], p2 + off2[s]));
+                            if (!depth_passes<kDepth>(z, fb.depth[base + s])) continue;
+                            if (draw.depth_write) fb.depth[base + s] = z;
+                        }
+                        passed |= std::uint64_t{1} << s;
+                    }
+                    if (!passed) continue;
+                    counters.samples_passed += static_cast<std::uint64_t>(__builtin_popcountll(passed));
+                    ++counters.shader_invocations;
+                    glm::vec4 color;
+                    if constexpr (kShading == Shading::constant || kShading == Shading::flat) {
+                        color = shade<kShading>(draw, tc, t, glm::dvec3(0.0), batch.clip_weights);
+                    } else {
+                        const std::int64_t half = kStep / 2;
+                        std::int64_t c0 = p0 + (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * half;
+                        std::int64_t c1 = p1 + (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * half;
+                        std::int64_t c2 = p2 + (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * half;
+                        if ((c0 | c1 | c2) < 0) {
+                            const int s = __builtin_ctzll(passed);
+                            c0 = p0 + off0[s];
+                            c1 = p1 + off1[s];
+                            c2 = p2 + off2[s];
+                        }
+                        color = shade<kShading>(draw, tc, t, screen_weights(t, c0, c1, c2), batch.clip_weights);
+                    }
+                    for (std::uint64_t m = passed; m; m &= m - 1)
+                        blend_into<kBlend>(&fb.color[4 * (base + __builtin_ctzll(m))], color);
+                } else {
+                    // Shade every covered sample that passes the depth test.
+                    for (; covered; covered &= covered - 1) {
+                        const int s = __builtin_ctzll(covered);
+                        ++counters.samples_covered;
+                        const std::int64_t e0 = p0 + off0[s], e1 = p1 + off1[s], e2 = p2 + off2[s];
+                        glm::dvec3 l(0.0);
+                        if constexpr (kDepth != DepthFunc::none || kShading == Shading::screen ||
+                                      kShading == Shading::perspective)
+                            l = screen_weights(t, e0, e1, e2);
+                        if constexpr (kDepth != DepthFunc::none) {
+                            const float z = sample_depth(t, l);
+                            if (!depth_passes<kDepth>(z, fb.depth[base + s])) continue;
+                            if (draw.depth_write) fb.depth[base + s] = z;
+                        }
+                        ++counters.samples_passed;
+                        ++counters.shader_invocations;
+                        blend_into<kBlend>(&fb.color[4 * (base + s)], shade<kShading>(draw, tc, t, l, batch.clip_weights));
+                    }
+                }
+            }
+        }
+    }
+}
+
+// Compile-time table of every instance, indexed by the key's enumerators.
+template <DepthFunc D, BlendMode B, Shading Sh>
+TileKernel pick_mode(SampleMode m) {
+    switch (m) {
+        case SampleMode::single: return &raster_tile<D, B, Sh, SampleMode::single>;
+        case SampleMode::ssaa: return &raster_tile<D, B, Sh, SampleMode::ssaa>;
+        case SampleMode::msaa: return &raster_tile<D, B, Sh, SampleMode::msaa>;
+    }
+    return nullptr;
+}
+
+template <DepthFunc D, BlendMode B>
+TileKernel pick_shading(const PipelineKey& k) {
+    switch (k.shading) {
+        case Shading::constant: return pick_mode<D, B, Shading::constant>(k.samples);
+        case Shading::flat: return pick_mode<D, B, Shading::flat>(k.samples);
+        case Shading::screen: return pick_mode<D, B, Shading::screen>(k.samples);
+        case Shading::perspective: return pick_mode<D, B, Shading::perspective>(k.samples);
+    }
+    return nullptr;
+}
+
+template <DepthFunc D>
+TileKernel pick_blend(const PipelineKey& k) {
+    switch (k.blend) {
+        case BlendMode::replace: return pick_shading<D, BlendMode::replace>(k);
+        case BlendMode::add: return pick_shading<D, BlendMode::add>(k);
+        case BlendMode::over: return pick_shading<D, BlendMode::over>(k);
+    }
+    return nullptr;
+}
+
+}  // namespace
+
+TileKernel select_tile_kernel(const PipelineKey& k) {
+    switch (k.depth) {
+        case DepthFunc::none: return pick_blend<DepthFunc::none>(k);
+        case DepthFunc::greater: return pick_blend<DepthFunc::greater>(k);
+        case DepthFunc::less: return pick_blend<DepthFunc::less>(k);
+    }
+    return nullptr;
+}
+
+}  // namespace mipraster

@@ -1,0 +1,248 @@
+#include "mipraster/pipeline/renderer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "mipraster/core/constants.hpp"
+#include "mipraster/core/thread_pool.hpp"
+#include "mipraster/pipeline/binning.hpp"
+#include "mipraster/pipeline/clip.hpp"
+#include "mipraster/pipeline/rasterize_tile.hpp"
+#include "mipraster/pipeline/vertex_transform.hpp"
+
+namespace mipraster {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// A run of one draw's triangles that one task clips, sets up and bins.
+struct ChunkRange {
+    std::uint32_t draw, first, last;
+};
+
+// Triangles per chunk: enough chunks for load balance, few enough that per-chunk tile tables stay
+// small. The split never changes the output (see BinnedChunk).
+constexpr std::size_t kMinChunkTriangles = 4096;
+
+void validate_draws(const std::vector<Draw>& draws) {
+    for (std::size_t i = 0; i < draws.size(); ++i) {
+        const std::string name = "draws[" + std::to_string(i) + "]";
+        if (!draws[i].mesh) throw std::invalid_argument(name + ".mesh is null");
+        draws[i].mesh->validate(name + ".mesh");
+        if (draws[i].mesh->triangles.size() >= (std::size_t{1} << 32))
+            throw std::invalid_argument(name + ".mesh has too many triangles (at most 2^32 - 1)");
+        for (int c = 0; c < 4; ++c)
+            if (!std::isfinite(draws[i].color[c]))
+                throw std::invalid_argument(name + ".color has a non-finite component");
+    }
+}
+
+PipelineKey pipeline_key(const Draw& draw, const Camera& camera, const RenderSettings& settings) {
+    PipelineKey key;
+    key.depth = !draw.state.depth_test ? DepthFunc::none
+                : camera.depth_convention == DepthConvention::opengl ? DepthFunc::less
+                                                                     : DepthFunc::greater;
+    key.blend = draw.state.blend;
+    if (!draw.mesh->has_colors()) key.shading = Shading::constant;  // nothing to interpolate
+    else if (draw.state.interpolation == Interpolation::flat) key.shading = Shading::flat;
+    else if (draw.state.interpolation == Interpolation::screen) key.shading = Shading::screen;
+    else key.shading = Shading::perspective;
+    key.samples = settings.samples == 1 ? SampleMode::single
+                  : settings.anti_aliasing == AntiAliasing::msaa ? SampleMode::msaa
+                                                                 : SampleMode::ssaa;
+    return key;
+}
+
+// Clip and set up one chunk of triangles, then bin them.
+void setup_chunk(const ChunkRange& range, const Draw& draw, const std::vector<glm::dvec4>& clip_positions,
+                 const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid, BinnedChunk& chunk,
+                 SetupCounters& counters, std::uint64_t& clipped) {
+    chunk.triangles.reserve(range.last - range.first);
+    SetupTriangle st;
+    ClipPolygon polygon;
+    for (std::uint32_t t = range.first; t < range.last; ++t) {
+        const glm::uvec3 tri = draw.mesh->triangles[t];
+        const std::array<glm::dvec4, 3> p = {clip_positions[tri[0]], clip_positions[tri[1]], clip_positions[tri[2]]};
+        bool finite = true;
+        for (const auto& v : p) finite &= std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w);
+        if (!finite) {
+            ++counters.dropped_nonfinite;
+            continue;
+        }
+        st.triangle = t;
+        st.draw = range.draw;
+        switch (clip_triangle(p[0], p[1], p[2], volume, polygon)) {
+            case ClipOutcome::outside: ++counters.culled_outside; break;
+            case ClipOutcome::inside:
+                st.clip_index = -1;
+                if (setup_triangle(p, viewport, draw.state.cull, st, counters)) chunk.triangles.push_back(st);
+                break;
+            case ClipOutcome::clipped: {
+                ++clipped;
+                // Fan-triangulate the clipped polygon; each piece keeps its original-triangle weights.
+                for (int i = 1; i + 1 < polygon.count; ++i) {
+                    const ClipVertex* v[3] = {&polygon.vertices[0], &polygon.vertices[i], &polygon.vertices[i + 1]};
+                    st.clip_index = static_cast<std::int32_t>(chunk.clip_weights.size());
+                    if (setup_triangle({v[0]->position, v[1]->position, v[2]->position}, viewport, draw.state.cull, st,
+                                       counters)) {
+                        chunk.triangles.push_back(st);
+                        chunk.clip_weights.push_back(
+                            {glm::vec3(v[0]->weights), glm::vec3(v[1]->weights), glm::vec3(v[2]->weights)});
+                    }
+                }
+                break;
+            }
+        }
+    }
+    bin_triangles(chunk, grid);
+}
+
+}  // namespace
+
+std::string to_string(AntiAliasing aa) { return aa == AntiAliasing::msaa ? "msaa" : "ssaa"; }
+
+AntiAliasing parse_anti_aliasing(const std::string& name) {
+    if (name == "ssaa") return AntiAliasing::ssaa;
+    if (name == "msaa") return AntiAliasing::msaa;
+    throw std::invalid_argument("anti-aliasing: unknown mode '" + name + "'; expected ssaa or msaa");
+}
+
+RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const RenderSettings& settings) {
+    const auto start = Clock::now();
+    // Validate everything before allocating anything large.
+    const bool needs_depth = std::any_of(draws.begin(), draws.end(), [](const Draw& d) { return d.state.depth_test; });
+    validate_framebuffer_size(settings.width, settings.height, settings.samples, needs_depth);
+    RenderResult result;
+    result.pattern = make_sample_pattern(settings.pattern, settings.samples, settings.pattern_seed);
+    validate_draws(draws);
+    const int threads = resolve_thread_count(settings.threads);
+    ThreadPool pool(threads);
+    RenderStats& stats = result.stats;
+    stats.threads = threads;
+
+    // Stage 1: vertex transform, per draw, in parallel over blocks of vertices.
+    auto t0 = Clock::now();
+    std::vector<std::vector<glm::dvec4>> clip_positions(draws.size());
+    for (std::size_t d = 0; d < draws.size(); ++d) {
+        const Mesh& mesh = *draws[d].mesh;
+        const glm::dmat4 mvp = camera.projection * camera.view * draws[d].model;
+        clip_positions[d].resize(mesh.positions.size());
+        constexpr std::size_t kBlock = 1 << 16;
+        pool.parallel_for((mesh.positions.size() + kBlock - 1) / kBlock, [&](std::size_t b) {
+            const std::size_t lo = b * kBlock, n = std::min(kBlock, mesh.positions.size() - lo);
+            transform_vertices(&mesh.positions[lo], n, mvp, &clip_positions[d][lo]);
+        });
+        stats.triangles_in += mesh.triangles.size();
+    }
+    stats.transform_ms = ms_since(t0);
+
+    // Stage 2: clip, set up and bin, in parallel over chunks of consecutive triangles.
+    t0 = Clock::now();
+    const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
+    const ClipVolume volume = make_clip_volume(camera.depth_convention, settings.width, settings.height);
+    const Viewport viewport{settings.width, settings.height, camera.depth_convention};
+    std::vector<ChunkRange> ranges;
+    for (std::uint32_t d = 0; d < draws.size(); ++d) {
+        const std::size_t n = draws[d].mesh->triangles.size();
+        const std::size_t size = std::max(kMinChunkTriangles, n / (4 * static_cast<std::size_t>(threads)) + 1);
+        for (std::size_t first = 0; first < n; first += size)
+            ranges.push_back({d, static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(std::min(n, first + size))});
+    }
+    std::vector<BinnedChunk> chunks(ranges.size());
+    std::vector<SetupCounters> setup_counters(ranges.size());
+    std::vector<std::uint64_t> clipped(ranges.size(), 0);
+    pool.parallel_for(ranges.size(), [&](std::size_t i) {
+        setup_chunk(ranges[i], draws[ranges[i].draw], clip_positions[ranges[i].draw], volume, viewport, grid, chunks[i],
+                    setup_counters[i], clipped[i]);
+    });
+    for (std::size_t i = 0; i < ranges.size(); ++i) {
+        stats.triangles_clipped += clipped[i];
+        stats.triangles_outside += setup_counters[i].culled_outside;
+        stats.triangles_backface += setup_counters[i].culled_backface;
+        stats.triangles_degenerate += setup_counters[i].culled_degenerate;
+        stats.triangles_nonfinite += setup_counters[i].dropped_nonfinite;
+        stats.triangles_rasterized += chunks[i].triangles.size();
+    }
+    stats.setup_ms = ms_since(t0);
+
+    // Stage 3: rasterize, shade, test and blend, one tile per task, triangles in submission order.
+    t0 = Clock::now();
+    const float clear_depth = camera.depth_convention == DepthConvention::opengl ? 1.0f : 0.0f;
+    Framebuffer fb = make_framebuffer(settings.width, settings.height, settings.samples, settings.clear_color,
+                                      needs_depth, clear_depth);
+    std::vector<TileKernel> kernels(draws.size());
+    std::vector<DrawInputs> inputs(draws.size());
+    for (std::size_t d = 0; d < draws.size(); ++d) {
+        kernels[d] = select_tile_kernel(pipeline_key(draws[d], camera, settings));
+        const Mesh& mesh = *draws[d].mesh;
+        inputs[d] = {mesh.triangles.data(), mesh.has_colors() ? mesh.colors.data() : nullptr, draws[d].color,
+                     draws[d].state.depth_write};
+    }
+    std::vector<TileCounters> tile_counters(static_cast<std::size_t>(grid.count()));
+    pool.parallel_for(static_cast<std::size_t>(grid.count()), [&](std::size_t tile) {
+        const int tx = static_cast<int>(tile) % grid.tiles_x, ty = static_cast<int>(tile) / grid.tiles_x;
+        const TileTarget target{&fb, &result.pattern, tx * kTileSize, ty * kTileSize,
+                                std::min((tx + 1) * kTileSize, settings.width),
+                                std::min((ty + 1) * kTileSize, settings.height)};
+        for (const BinnedChunk& chunk : chunks) {
+            const std::uint32_t* begin = chunk.tile_triangles.data() + chunk.tile_start[tile];
+            const std::uint32_t* end = chunk.tile_triangles.data() + chunk.tile_start[tile + 1];
+            // A chunk holds one draw's triangles: one kernel call per chunk and tile.
+            if (begin == end) continue;
+            const std::uint32_t draw = chunk.triangles[*begin].draw;
+            const TriangleBatch batch{chunk.triangles.data(), begin, static_cast<std::size_t>(end - begin),
+                                      chunk.clip_weights.data()};
+            kernels[draw](target, inputs[draw], batch, tile_counters[tile]);
+        }
+    });
+    for (const TileCounters& c : tile_counters) {
+        stats.samples_covered += c.samples_covered;
+        stats.samples_passed += c.samples_passed;
+        stats.shader_invocations += c.shader_invocations;
+    }
+    stats.raster_ms = ms_since(t0);
+
+    // Stage 4: resolve (no pass at all for one sample per pixel unless the samples are kept).
+    t0 = Clock::now();
+    if (settings.keep_samples) {
+        result.color = resolve_color(static_cast<const Framebuffer&>(fb), settings.resolve_filter, pool);
+        result.framebuffer = std::move(fb);
+    } else {
+        result.color = resolve_color(std::move(fb), settings.resolve_filter, pool);
+    }
+    stats.resolve_ms = ms_since(t0);
+    stats.total_ms = ms_since(start);
+    return result;
+}
+
+std::string RenderSettings::to_string() const {
+    return "RenderSettings(" + std::to_string(width) + "x" + std::to_string(height) + ", samples=" +
+           std::to_string(samples) + ", pattern=" + mipraster::to_string(pattern) + ", aa=" +
+           mipraster::to_string(anti_aliasing) + ", threads=" + std::to_string(threads) + ", resolve=" +
+           mipraster::to_string(resolve_filter) + ")";
+}
+
+std::string RenderStats::to_string() const {
+    auto ms = [](double v) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%.3f", v);
+        return std::string(buf);
+    };
+    return "RenderStats(triangles_in=" + std::to_string(triangles_in) + ", clipped=" + std::to_string(triangles_clipped) +
+           ", outside=" + std::to_string(triangles_outside) + ", backface=" + std::to_string(triangles_backface) +
+           ", degenerate=" + std::to_string(triangles_degenerate) + ", nonfinite=" + std::to_string(triangles_nonfinite) +
+           ", rasterized=" + std::to_string(triangles_rasterized) + ", samples_covered=" + std::to_string(samples_covered) +
+           ", samples_passed=" + std::to_string(samples_passed) + ", shader_invocations=" +
+           std::to_string(shader_invocations) + ", threads=" + std::to_string(threads) + ", transform_ms=" +
+           ms(transform_ms) + ", setup_ms=" + ms(setup_ms) + ", raster_ms=" + ms(raster_ms) + ", resolve_ms=" +
+           ms(resolve_ms) + ", total_ms=" + ms(total_ms) + ")";
+}
+
+}  // namespace mipraster

@@ -1,0 +1,109 @@
+#include "mipraster/pipeline/sample_pattern.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "mipraster/core/constants.hpp"
+
+namespace mipraster {
+
+namespace {
+
+int exact_square_root(int n) {
+    const int r = static_cast<int>(std::lround(std::sqrt(static_cast<double>(n))));
+    return r * r == n ? r : 0;
+}
+
+// splitmix64: a small, well-mixed generator so a seed gives the same pattern everywhere.
+std::uint64_t splitmix64(std::uint64_t& state) {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+}  // namespace
+
+std::string to_string(PatternKind kind) {
+    switch (kind) {
+        case PatternKind::automatic: return "auto";
+        case PatternKind::center: return "center";
+        case PatternKind::grid: return "grid";
+        case PatternKind::rotated: return "rotated";
+        case PatternKind::stratified: return "stratified";
+    }
+    return "?";
+}
+
+PatternKind parse_pattern_kind(const std::string& name) {
+    for (PatternKind k : {PatternKind::automatic, PatternKind::center, PatternKind::grid, PatternKind::rotated,
+                          PatternKind::stratified})
+        if (name == to_string(k)) return k;
+    throw std::invalid_argument("pattern: unknown name '" + name +
+                                "'; expected one of auto, center, grid, rotated, stratified");
+}
+
+SamplePattern make_sample_pattern(PatternKind kind, int samples, std::uint64_t seed) {
+    if (samples < 1 || samples > kMaxSamples)
+        throw std::invalid_argument("samples per pixel: expected 1 to " + std::to_string(kMaxSamples) + ", got " +
+                                    std::to_string(samples));
+    const int n = exact_square_root(samples);
+    if (kind == PatternKind::automatic)
+        kind = samples == 1 ? PatternKind::center : samples == 4 ? PatternKind::rotated : PatternKind::grid;
+    SamplePattern p;
+    p.kind = kind;
+    auto add = [&](std::int32_t ox, std::int32_t oy) {
+        p.x.push_back(ox);
+        p.y.push_back(oy);
+    };
+    switch (kind) {
+        case PatternKind::center:
+            if (samples != 1)
+                throw std::invalid_argument("pattern 'center' has 1 sample; got samples=" + std::to_string(samples));
+            add(128, 128);
+            break;
+        case PatternKind::rotated:
+            if (samples != 4)
+                throw std::invalid_argument("pattern 'rotated' has 4 samples; got samples=" + std::to_string(samples));
+            // (0.375,0.125) (0.875,0.375) (0.125,0.625) (0.625,0.875) in 1/256 px.
+            add(96, 32);
+            add(224, 96);
+            add(32, 160);
+            add(160, 224);
+            break;
+        case PatternKind::grid:
+        case PatternKind::stratified: {
+            if (n == 0)
+                throw std::invalid_argument("pattern '" + to_string(kind) +
+                                            "' needs a square sample count (1, 4, 9, 16, 25, 36, 49, 64); got samples=" +
+                                            std::to_string(samples));
+            std::uint64_t state = seed;
+            for (int b = 0; b < n; ++b)
+                for (int a = 0; a < n; ++a) {
+                    if (kind == PatternKind::grid) {
+                        // (a+½)/N·256 rounded half-up; exact when N divides 128.
+                        add(static_cast<std::int32_t>((256 * (2 * a + 1) + n) / (2 * n)),
+                            static_cast<std::int32_t>((256 * (2 * b + 1) + n) / (2 * n)));
+                    } else {
+                        // Stratum [a/N, (a+1)/N) on the 1/256 grid: offsets lo … hi−1.
+                        const int lo_x = 256 * a / n, hi_x = 256 * (a + 1) / n;
+                        const int lo_y = 256 * b / n, hi_y = 256 * (b + 1) / n;
+                        add(lo_x + static_cast<std::int32_t>(splitmix64(state) % static_cast<std::uint64_t>(hi_x - lo_x)),
+                            lo_y + static_cast<std::int32_t>(splitmix64(state) % static_cast<std::uint64_t>(hi_y - lo_y)));
+                    }
+                }
+            break;
+        }
+        case PatternKind::automatic: break;
+    }
+    return p;
+}
+
+std::string SamplePattern::to_string() const {
+    std::string s = "SamplePattern(" + mipraster::to_string(kind) + ", [";
+    for (int i = 0; i < count(); ++i)
+        s += (i ? ", (" : "(") + std::to_string(x[i]) + "/256, " + std::to_string(y[i]) + "/256)";
+    return s + "])";
+}
+
+}  // namespace mipraster

@@ -1,0 +1,93 @@
+#include "mipraster/pipeline/triangle_setup.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mipraster/core/constants.hpp"
+
+namespace mipraster {
+
+namespace {
+
+// ⌊v / 256⌋ for negative v too.
+std::int64_t floor_to_pixel(std::int64_t v) {
+    return v >= 0 ? v / kSubpixelOne : -((-v + kSubpixelOne - 1) / kSubpixelOne);
+}
+
+}  // namespace
+
+bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport, CullMode cull, SetupTriangle& out,
+                    SetupCounters& counters) {
+    // Step 1: project to screen (y down) and snap to 1/256 px, round half to even (the default
+    // rounding mode of nearbyint). Clipping bounded |x|, |y| by the guard band.
+    std::int64_t X[3], Y[3];
+    double zw[3], inv_w[3];
+    const double half_w = 0.5 * viewport.width, half_h = 0.5 * viewport.height;
+    const double limit = static_cast<double>(kMaxFixedCoordinate);
+    for (int i = 0; i < 3; ++i) {
+        inv_w[i] = 1.0 / p[i].w;
+        const double xs = std::nearbyint((p[i].x * inv_w[i] + 1.0) * half_w * kSubpixelOne);
+        const double ys = std::nearbyint((1.0 - p[i].y * inv_w[i]) * half_h * kSubpixelOne);
+        const double z = p[i].z * inv_w[i];
+        zw[i] = viewport.depth_convention == DepthConvention::opengl ? 0.5 * z + 0.5 : z;
+        // Only finite, in-range values may be converted to integers.
+        if (!(std::fabs(xs) <= limit && std::fabs(ys) <= limit && std::isfinite(zw[i]) && std::isfinite(inv_w[i]))) {
+            ++counters.dropped_nonfinite;
+            return false;
+        }
+        X[i] = static_cast<std::int64_t>(xs);
+        Y[i] = static_cast<std::int64_t>(ys);
+    }
+
+    // Step 2: orientation and culling. area2 > 0 ⇔ clockwise on screen (y down) ⇔
+    // counter-clockwise in NDC (y up) ⇔ front facing.
+    std::int64_t area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+    if (area2 == 0) {
+        ++counters.culled_degenerate;
+        return false;
+    }
+    if ((cull == CullMode::back && area2 < 0) || (cull == CullMode::front && area2 > 0)) {
+        ++counters.culled_backface;
+        return false;
+    }
+
+    // Step 3: bounds in pixels: pixel px holds samples at px·256 + [0, 255].
+    const std::int64_t min_x = std::max<std::int64_t>(floor_to_pixel(std::min({X[0], X[1], X[2]})), 0);
+    const std::int64_t max_x = std::min<std::int64_t>(floor_to_pixel(std::max({X[0], X[1], X[2]})), viewport.width - 1);
+    const std::int64_t min_y = std::max<std::int64_t>(floor_to_pixel(std::min({Y[0], Y[1], Y[2]})), 0);
+    const std::int64_t max_y = std::min<std::int64_t>(floor_to_pixel(std::max({Y[0], Y[1], Y[2]})), viewport.height - 1);
+    if (min_x > max_x || min_y > max_y) {
+        ++counters.culled_outside;
+        return false;
+    }
+
+    // Step 4: edge equations, oriented so the inside is positive whatever the winding, with the
+    // top-left rule: a sample exactly on an edge belongs to the triangle only if the edge is a
+    // left edge (inside to its right: a > 0) or a top edge (horizontal, inside below: a = 0, b > 0).
+    const std::int64_t sign = area2 > 0 ? 1 : -1;
+    for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3, k = (i + 2) % 3;  // edge j → k is opposite vertex i
+        const std::int64_t a = sign * (Y[j] - Y[k]);
+        const std::int64_t b = sign * (X[k] - X[j]);
+        const std::int64_t c = -(a * X[j] + b * Y[j]);
+        const bool top_left = a > 0 || (a == 0 && b > 0);
+        out.edge_a[i] = static_cast<std::int32_t>(a);
+        out.edge_b[i] = static_cast<std::int32_t>(b);
+        out.bias[i] = top_left ? 0 : 1;
+        out.edge_c[i] = c - out.bias[i];
+    }
+    out.min_x = static_cast<std::int32_t>(min_x);
+    out.max_x = static_cast<std::int32_t>(max_x);
+    out.min_y = static_cast<std::int32_t>(min_y);
+    out.max_y = static_cast<std::int32_t>(max_y);
+    out.inv_area2 = 1.0 / static_cast<double>(sign * area2);
+
+    // Step 5: depth (affine in screen space) and 1/w planes.
+    out.z0 = static_cast<float>(zw[0]);
+    out.dz1 = static_cast<float>(zw[1] - zw[0]);
+    out.dz2 = static_cast<float>(zw[2] - zw[0]);
+    for (int i = 0; i < 3; ++i) out.inv_w[i] = static_cast<float>(inv_w[i]);
+    return true;
+}
+
+}  // namespace mipraster
