@@ -1,0 +1,36 @@
+#pragma once
+// Image files: PNG (sRGB 8-bit) and OpenEXR (linear float) output, and input from any format
+// OpenImageIO reads. This is the only part of mipraster that depends on OpenImageIO; its header
+// names no OpenImageIO type, so including it pulls in nothing from that library.
+#include <string>
+
+#include "mipraster/core/image.hpp"
+
+namespace mipraster {
+
+/// Writes `image` to `path`; the format follows the extension, compared case-insensitively:
+///  - `.png`: 8-bit. A 4-channel image (linear, premultiplied RGBA) is un-premultiplied and
+///    sRGB-encoded with `to_srgb8()`, alpha stored linearly (straight alpha, as PNG defines it).
+///    A 3-channel image (linear RGB, opaque) is sRGB-encoded the same way and written as RGB.
+///    A 1-channel image (data such as depth or a mask) is written as plain grey:
+///    round(clamp(v, 0, 1) · 255), with no sRGB encoding and NaN written as 0.
+///  - `.exr`: 32-bit float, values written exactly as they are (linear; RGBA stays premultiplied,
+///    as OpenEXR defines it); 1-channel images are stored as channel "Y".
+/// Throws std::invalid_argument for another extension or a malformed image (channels other
+/// than 1, 3 or 4, zero size, pixel count not width·height·channels), and std::runtime_error
+/// naming the path and OpenImageIO's message when the file cannot be opened or written.
+void write_image(const std::string& path, const Image& image);
+
+/// Reads any file OpenImageIO can read into a linear, premultiplied RGBA float image (C = 4,
+/// row 0 at the top). Integer-typed files (8-bit PNG or JPEG, 16-bit PNG, …) are taken as
+/// sRGB-encoded with straight alpha: colour channels are decoded with `srgb_to_linear`, alpha
+/// is used linearly (code / max code), and colour is then multiplied by alpha. Float-typed
+/// files (EXR, HDR, float TIFF) are read as they are, already linear and premultiplied.
+/// Grey becomes (g, g, g, 1), grey+alpha (g, g, g, a), RGB gets alpha 1; channels past the
+/// fourth are ignored. Only the first subimage and MIP level is read.
+/// Note: a 1-channel PNG from `write_image` holds plain (not sRGB) grey, but reading it back
+/// decodes it as sRGB like any 8-bit file; store data images as EXR to read them back exactly.
+/// Throws std::runtime_error naming the path when the file is missing, unreadable or corrupt.
+Image read_image(const std::string& path);
+
+}  // namespace mipraster

@@ -1,0 +1,180 @@
+#include "mipraster/io/image_io.hpp"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+#include "mipraster/core/colour.hpp"
+
+namespace mipraster {
+namespace {
+
+enum class FileKind { png, exr };
+
+std::string lower_extension(const std::string& path) {
+    const std::size_t slash = path.find_last_of("/\\");
+    const std::size_t dot = path.find_last_of('.');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+    std::string ext = path.substr(dot);
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+    return ext;
+}
+
+FileKind output_kind(const std::string& path) {
+    const std::string ext = lower_extension(path);
+    if (ext == ".png") return FileKind::png;
+    if (ext == ".exr") return FileKind::exr;
+    const std::string what = ext.empty() ? "no file extension" : "unsupported extension '" + ext + "'";
+    throw std::invalid_argument("write_image: cannot write '" + path + "': " + what +
+                                " (supported: .png for sRGB 8-bit, .exr for linear float)");
+}
+
+void check_image(const std::string& path, const Image& image) {
+    if (image.width <= 0 || image.height <= 0)
+        throw std::invalid_argument("write_image: cannot write '" + path + "': image is empty (" +
+                                    image.to_string() + ")");
+    if (image.channels != 1 && image.channels != 3 && image.channels != 4)
+        throw std::invalid_argument("write_image: cannot write '" + path + "': " + image.to_string() +
+                                    " has " + std::to_string(image.channels) +
+                                    " channels, expected 1 (grey/data), 3 (RGB) or 4 (premultiplied RGBA)");
+    const std::size_t expected = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) *
+                                 static_cast<std::size_t>(image.channels);
+    if (image.pixels.size() != expected)
+        throw std::invalid_argument("write_image: cannot write '" + path + "': " + image.to_string() + " holds " +
+                                    std::to_string(image.pixels.size()) + " values, expected width*height*channels = " +
+                                    std::to_string(expected));
+}
+
+// 1-channel PNG: plain grey, round(clamp(v, 0, 1) * 255); NaN → 0.
+std::vector<std::uint8_t> grey8(const Image& image) {
+    std::vector<std::uint8_t> out(image.pixels.size());
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        const float v = image.pixels[i];
+        const float clamped = v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f;  // NaN fails v > 0
+        out[i] = static_cast<std::uint8_t>(std::lround(clamped * 255.0f));
+    }
+    return out;
+}
+
+// Step: open, write all scanlines, close — each failure reported with the path.
+void write_pixels(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc format, const void* data) {
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) throw std::runtime_error("write_image: cannot create a writer for '" + path + "': " + OIIO::geterror());
+    if (!out->open(path, spec))
+        throw std::runtime_error("write_image: cannot open '" + path + "' for writing: " + out->geterror());
+    if (!out->write_image(format, data)) {
+        const std::string message = out->geterror();
+        out->close();
+        throw std::runtime_error("write_image: cannot write '" + path + "': " + message);
+    }
+    if (!out->close()) throw std::runtime_error("write_image: cannot finish '" + path + "': " + out->geterror());
+}
+
+}  // namespace
+
+void write_image(const std::string& path, const Image& image) {
+    const FileKind kind = output_kind(path);
+    check_image(path, image);
+
+    if (kind == FileKind::exr) {
+        OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::FLOAT);
+        if (image.channels == 1) spec.channelnames = {"Y"};
+        spec.attribute("compression", "zip");  // lossless
+        write_pixels(path, spec, OIIO::TypeDesc::FLOAT, image.pixels.data());
+        return;
+    }
+
+    // PNG
+    if (image.channels == 1) {
+        const std::vector<std::uint8_t> bytes = grey8(image);
+        OIIO::ImageSpec spec(image.width, image.height, 1, OIIO::TypeDesc::UINT8);
+        spec.channelnames = {"Y"};
+        write_pixels(path, spec, OIIO::TypeDesc::UINT8, bytes.data());
+        return;
+    }
+    std::vector<std::uint8_t> bytes = to_srgb8(image);  // straight-alpha sRGB8 RGBA
+    int channels = 4;
+    if (image.channels == 3) {  // drop the (opaque) alpha that to_srgb8 adds
+        const std::size_t n = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+        for (std::size_t p = 0; p < n; ++p)
+            for (int c = 0; c < 3; ++c) bytes[p * 3 + c] = bytes[p * 4 + c];
+        bytes.resize(n * 3);
+        channels = 3;
+    }
+    OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:ColorSpace", "sRGB");
+    // The bytes already hold straight alpha; without this OpenImageIO would un-premultiply again.
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+    write_pixels(path, spec, OIIO::TypeDesc::UINT8, bytes.data());
+}
+
+Image read_image(const std::string& path) {
+    // Step: open. Ask for the file's own (straight) alpha so that we premultiply in linear space.
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
+    if (!in) {
+        std::string message = OIIO::geterror();
+        std::error_code ec;
+        if (!std::filesystem::exists(path, ec)) message = "no such file";
+        throw std::runtime_error("read_image: cannot read '" + path + "': " + message);
+    }
+    const OIIO::ImageSpec spec = in->spec();
+    const int w = spec.width, h = spec.height, nch = spec.nchannels;
+    if (w <= 0 || h <= 0 || nch <= 0)
+        throw std::runtime_error("read_image: '" + path + "' has no pixels (" + std::to_string(w) + "x" +
+                                 std::to_string(h) + "x" + std::to_string(nch) + ")");
+
+    // Step: read every channel as float in [0, 1] (integers) or as stored (floats).
+    const OIIO::TypeDesc stored = spec.format;
+    const bool is_float = stored.basetype == OIIO::TypeDesc::FLOAT || stored.basetype == OIIO::TypeDesc::HALF ||
+                          stored.basetype == OIIO::TypeDesc::DOUBLE;
+    const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+    std::vector<float> raw(n * static_cast<std::size_t>(nch));
+    bool ok = true;
+    if (stored == OIIO::TypeDesc::UINT8) {
+        // 8-bit: convert code / 255 ourselves so that decoding is exact and independent of OIIO.
+        std::vector<std::uint8_t> bytes(raw.size());
+        ok = in->read_image(0, 0, 0, nch, OIIO::TypeDesc::UINT8, bytes.data());
+        for (std::size_t i = 0; i < raw.size(); ++i) raw[i] = static_cast<float>(bytes[i]) / 255.0f;
+    } else {
+        ok = in->read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, raw.data());
+    }
+    if (!ok) throw std::runtime_error("read_image: cannot read pixels of '" + path + "': " + in->geterror());
+    in->close();
+
+    // Step: pick the colour and alpha channels.
+    int alpha = spec.alpha_channel;
+    if (alpha < 0 || alpha >= nch) alpha = nch == 2 ? 1 : (nch >= 4 ? 3 : -1);
+    if (nch == 1) alpha = -1;  // a single channel is grey, whatever it is named
+    std::array<int, 3> colour{};
+    int found = 0;
+    for (int c = 0; c < nch && found < 3; ++c)
+        if (c != alpha) colour[found++] = c;
+    if (found < 3) colour = {colour[0], colour[0], colour[0]};  // grey (or grey + alpha)
+
+    // Step: decode sRGB for integer files and premultiply; float files are taken as they are.
+    Image image(w, h, 4);
+    for (std::size_t p = 0; p < n; ++p) {
+        const float* src = &raw[p * nch];
+        float* dst = &image.pixels[p * 4];
+        const float a = alpha >= 0 ? src[alpha] : 1.0f;
+        for (int c = 0; c < 3; ++c) {
+            const float v = src[colour[c]];
+            dst[c] = is_float ? v : srgb_to_linear(v) * a;
+        }
+        dst[3] = a;
+    }
+    return image;
+}
+
+}  // namespace mipraster
