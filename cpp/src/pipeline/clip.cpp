@@ -45,25 +45,28 @@ ClipVertex intersect(const ClipVertex& a, double da, const ClipVertex& b, double
 
 }  // namespace
 
-ClipOutcome clip_triangle(const glm::dvec4& p0, const glm::dvec4& p1, const glm::dvec4& p2, const ClipVolume& volume,
-                          ClipPolygon& out) {
-    // Trivial accept / reject by the per-plane outcodes.
-    bool crosses = false;
-    for (const ClipPlane& plane : volume.planes) {
-        const int inside = (plane.distance(p0) >= 0.0) + (plane.distance(p1) >= 0.0) + (plane.distance(p2) >= 0.0);
-        if (inside == 0) return ClipOutcome::outside;
-        crosses |= inside != 3;
-    }
-    if (!crosses) return ClipOutcome::inside;
+std::uint8_t outcode(const glm::dvec4& p, const ClipVolume& volume) {
+    std::uint8_t code = 0;
+    for (int i = 0; i < kClipPlaneCount; ++i)
+        if (!(volume.planes[i].distance(p) >= 0.0)) code |= static_cast<std::uint8_t>(1u << i);
+    return code;
+}
+
+ClipOutcome clip_triangle(const std::array<glm::dvec4, 3>& p, const std::array<std::uint8_t, 3>& outcodes,
+                          const ClipVolume& volume, ClipPolygon& out) {
+    if ((outcodes[0] | outcodes[1] | outcodes[2]) == 0) return ClipOutcome::inside;
+    if ((outcodes[0] & outcodes[1] & outcodes[2]) != 0) return ClipOutcome::outside;
 
     // Sutherland–Hodgman, one plane at a time, ping-ponging between two polygons.
     ClipPolygon scratch;
     ClipPolygon* src = &out;
     ClipPolygon* dst = &scratch;
     src->count = 3;
-    src->vertices[0] = {p0, {1, 0, 0}};
-    src->vertices[1] = {p1, {0, 1, 0}};
-    src->vertices[2] = {p2, {0, 0, 1}};
+    src->vertices[0] = {p[0], {1, 0, 0}};
+    src->vertices[1] = {p[1], {0, 1, 0}};
+    src->vertices[2] = {p[2], {0, 0, 1}};
+    // Every plane, even one no input vertex crosses: a rounded crossing point may lie a hair
+    // outside it, and a neighbour sharing the edge must make the same cut.
     for (const ClipPlane& plane : volume.planes) {
         dst->count = 0;
         for (int i = 0; i < src->count; ++i) {

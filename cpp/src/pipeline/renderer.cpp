@@ -27,6 +27,15 @@ struct ChunkRange {
     std::uint32_t draw, first, last;
 };
 
+// A draw's vertices in clip space, with the clip volume's outcode of each (kNonFinite marks a
+// vertex with a NaN or infinite coordinate, e.g. from a degenerate matrix).
+struct ClipSpaceVertices {
+    std::vector<glm::dvec4> positions;
+    std::vector<std::uint8_t> outcodes;
+};
+constexpr std::uint8_t kNonFinite = 0x80;
+static_assert(kClipPlaneCount < 8, "kNonFinite must not collide with a plane bit");
+
 // Triangles per chunk: enough chunks for load balance, few enough that per-chunk tile tables stay
 // small. The split never changes the output (see BinnedChunk).
 constexpr std::size_t kMinChunkTriangles = 4096;
@@ -61,7 +70,7 @@ PipelineKey pipeline_key(const Draw& draw, const Camera& camera, const RenderSet
 }
 
 // Clip and set up one chunk of triangles, then bin them.
-void setup_chunk(const ChunkRange& range, const Draw& draw, const std::vector<glm::dvec4>& clip_positions,
+void setup_chunk(const ChunkRange& range, const Draw& draw, const ClipSpaceVertices& vertices,
                  const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid, BinnedChunk& chunk,
                  SetupCounters& counters, std::uint64_t& clipped) {
     chunk.triangles.reserve(range.last - range.first);
@@ -69,16 +78,17 @@ void setup_chunk(const ChunkRange& range, const Draw& draw, const std::vector<gl
     ClipPolygon polygon;
     for (std::uint32_t t = range.first; t < range.last; ++t) {
         const glm::uvec3 tri = draw.mesh->triangles[t];
-        const std::array<glm::dvec4, 3> p = {clip_positions[tri[0]], clip_positions[tri[1]], clip_positions[tri[2]]};
-        bool finite = true;
-        for (const auto& v : p) finite &= std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w);
-        if (!finite) {
+        const std::array<std::uint8_t, 3> codes = {vertices.outcodes[tri[0]], vertices.outcodes[tri[1]],
+                                                   vertices.outcodes[tri[2]]};
+        if ((codes[0] | codes[1] | codes[2]) & kNonFinite) {
             ++counters.dropped_nonfinite;
             continue;
         }
+        const std::array<glm::dvec4, 3> p = {vertices.positions[tri[0]], vertices.positions[tri[1]],
+                                             vertices.positions[tri[2]]};
         st.triangle = t;
         st.draw = range.draw;
-        switch (clip_triangle(p[0], p[1], p[2], volume, polygon)) {
+        switch (clip_triangle(p, codes, volume, polygon)) {
             case ClipOutcome::outside: ++counters.culled_outside; break;
             case ClipOutcome::inside:
                 st.clip_index = -1;
@@ -129,15 +139,23 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
 
     // Stage 1: vertex transform, per draw, in parallel over blocks of vertices.
     auto t0 = Clock::now();
-    std::vector<std::vector<glm::dvec4>> clip_positions(draws.size());
+    const ClipVolume volume = make_clip_volume(camera.depth_convention, settings.width, settings.height);
+    std::vector<ClipSpaceVertices> clip_space(draws.size());
     for (std::size_t d = 0; d < draws.size(); ++d) {
         const Mesh& mesh = *draws[d].mesh;
         const glm::dmat4 mvp = camera.projection * camera.view * draws[d].model;
-        clip_positions[d].resize(mesh.positions.size());
+        ClipSpaceVertices& out = clip_space[d];
+        out.positions.resize(mesh.positions.size());
+        out.outcodes.resize(mesh.positions.size());
         constexpr std::size_t kBlock = 1 << 16;
         pool.parallel_for((mesh.positions.size() + kBlock - 1) / kBlock, [&](std::size_t b) {
             const std::size_t lo = b * kBlock, n = std::min(kBlock, mesh.positions.size() - lo);
-            transform_vertices(&mesh.positions[lo], n, mvp, &clip_positions[d][lo]);
+            transform_vertices(&mesh.positions[lo], n, mvp, &out.positions[lo]);
+            for (std::size_t i = lo; i < lo + n; ++i) {
+                const glm::dvec4& p = out.positions[i];
+                const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w);
+                out.outcodes[i] = finite ? outcode(p, volume) : kNonFinite;
+            }
         });
         stats.triangles_in += mesh.triangles.size();
     }
@@ -146,7 +164,6 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     // Stage 2: clip, set up and bin, in parallel over chunks of consecutive triangles.
     t0 = Clock::now();
     const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
-    const ClipVolume volume = make_clip_volume(camera.depth_convention, settings.width, settings.height);
     const Viewport viewport{settings.width, settings.height, camera.depth_convention};
     std::vector<ChunkRange> ranges;
     for (std::uint32_t d = 0; d < draws.size(); ++d) {
@@ -159,7 +176,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     std::vector<SetupCounters> setup_counters(ranges.size());
     std::vector<std::uint64_t> clipped(ranges.size(), 0);
     pool.parallel_for(ranges.size(), [&](std::size_t i) {
-        setup_chunk(ranges[i], draws[ranges[i].draw], clip_positions[ranges[i].draw], volume, viewport, grid, chunks[i],
+        setup_chunk(ranges[i], draws[ranges[i].draw], clip_space[ranges[i].draw], volume, viewport, grid, chunks[i],
                     setup_counters[i], clipped[i]);
     });
     for (std::size_t i = 0; i < ranges.size(); ++i) {

@@ -39,14 +39,15 @@ bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport
         Y[i] = static_cast<std::int64_t>(ys);
     }
 
-    // Step 2: orientation and culling. area2 > 0 ⇔ clockwise on screen (y down) ⇔
-    // counter-clockwise in NDC (y up) ⇔ front facing.
+    // Step 2: orientation and culling. In y-down coordinates area2 > 0 means the triangle
+    // appears clockwise (on screen and in NDC alike: the flip changes the formula's sign, not
+    // the picture), so front faces (counter-clockwise) have area2 < 0.
     std::int64_t area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
     if (area2 == 0) {
         ++counters.culled_degenerate;
         return false;
     }
-    if ((cull == CullMode::back && area2 < 0) || (cull == CullMode::front && area2 > 0)) {
+    if ((cull == CullMode::back && area2 > 0) || (cull == CullMode::front && area2 < 0)) {
         ++counters.culled_backface;
         return false;
     }

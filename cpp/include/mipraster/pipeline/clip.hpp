@@ -2,6 +2,7 @@
 // Homogeneous clipping: always against the near (and far) plane, against the sides only where a
 // triangle leaves the guard band, so that every coordinate after it fits the fixed-point range.
 #include <array>
+#include <cstdint>
 
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
@@ -24,6 +25,7 @@ struct ClipPlane {
 };
 
 inline constexpr int kClipPlaneCount = 7;  // near, far, w > 0, and four guard-band sides
+static_assert(kClipPlaneCount <= 8, "outcodes are 8-bit masks");
 
 struct ClipVolume {
     std::array<ClipPlane, kClipPlaneCount> planes;
@@ -41,10 +43,15 @@ struct ClipPolygon {
 
 enum class ClipOutcome { inside, outside, clipped };
 
-/// Classifies the triangle; when it crosses a plane, fills `out` with the clipped polygon
-/// (Sutherland–Hodgman). Each crossing point is computed from its edge's endpoints in a fixed
-/// order, so a shared edge clips to bit-identical vertices from either triangle.
-ClipOutcome clip_triangle(const glm::dvec4& p0, const glm::dvec4& p1, const glm::dvec4& p2, const ClipVolume& volume,
-                          ClipPolygon& out);
+/// Bit i set ⇔ p is outside plane i. Computed once per vertex; a triangle is trivially inside
+/// when its vertices' outcodes OR to 0 and trivially outside when they AND to non-zero.
+std::uint8_t outcode(const glm::dvec4& p, const ClipVolume& volume);
+
+/// Classifies the triangle by its vertices' outcodes; when it crosses a plane, fills `out` with
+/// the clipped polygon (Sutherland–Hodgman). Each crossing point is computed from its edge's
+/// endpoints in a fixed order, so a shared edge clips to bit-identical vertices from either
+/// triangle.
+ClipOutcome clip_triangle(const std::array<glm::dvec4, 3>& p, const std::array<std::uint8_t, 3>& outcodes,
+                          const ClipVolume& volume, ClipPolygon& out);
 
 }  // namespace mipraster

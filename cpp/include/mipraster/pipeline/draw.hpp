@@ -23,7 +23,8 @@ enum class Interpolation {
     perspective,  ///< perspective-correct (interpolate a/w and 1/w, divide)
 };
 
-enum class CullMode { none, back, front };  ///< front faces are counter-clockwise in NDC (y up)
+/// Face culling. Front faces wind counter-clockwise as seen on screen (OpenGL's default).
+enum class CullMode { none, back, front };
 
 std::string to_string(BlendMode mode);
 std::string to_string(Interpolation mode);

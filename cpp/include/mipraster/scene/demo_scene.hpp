@@ -1,0 +1,22 @@
+#pragma once
+// The built-in demo: a lit, vertex-coloured cube on a checkered ground plane that runs to the
+// horizon — thin far-away checks and the cube's silhouette show what antialiasing does.
+#include <memory>
+#include <vector>
+
+#include "mipraster/pipeline/draw.hpp"
+#include "mipraster/scene/camera.hpp"
+
+namespace mipraster {
+
+struct DemoScene {
+    std::vector<std::shared_ptr<Mesh>> meshes;  ///< owned here; draws point into them
+    std::vector<Draw> draws;
+    Camera camera;
+    glm::vec4 clear_color;  ///< sky colour, linear premultiplied
+};
+
+/// Builds the demo for an image of the given aspect ratio (width / height).
+DemoScene make_demo_scene(double aspect);
+
+}  // namespace mipraster

@@ -1,0 +1,114 @@
+"""The installed `mipraster` command: the demo render, its options, and its error messages."""
+import os
+import shutil
+import subprocess
+import sysconfig
+
+import numpy as np
+import pytest
+from PIL import Image
+
+
+def _find_exe():
+    for d in (sysconfig.get_path("scripts"), sysconfig.get_path("scripts", f"{os.name}_user")):
+        p = os.path.join(d, "mipraster")
+        if os.access(p, os.X_OK):
+            return p
+    p = shutil.which("mipraster")
+    assert p, "the mipraster executable is not installed (run `pip install .`)"
+    return p
+
+
+EXE = _find_exe()
+
+
+def run(*args):
+    return subprocess.run([EXE, *args], capture_output=True, text=True, timeout=300)
+
+
+def render_png(tmp_path, name, *args):
+    out = tmp_path / name
+    r = run("render", "-o", str(out), *args)
+    assert r.returncode == 0, r.stderr
+    assert str(out) in r.stdout
+    return np.asarray(Image.open(out))
+
+
+def test_demo_renders_png_of_requested_size(tmp_path):
+    img = render_png(tmp_path, "demo.png", "--size", "96x64")
+    assert img.shape == (64, 96, 4)
+    assert img.dtype == np.uint8
+    assert (img[..., 3] == 255).all()  # sky and ground cover every pixel
+
+
+def test_supersampling_antialiases_edges(tmp_path):
+    # At 1 spp every pixel takes one of the few flat colours of the scene (plus the cube's
+    # gradients); at 16 spp edge pixels are blends, so the image has many more distinct colours
+    # while the average brightness stays the same.
+    one = render_png(tmp_path, "s1.png", "--size", "160x90", "--spp", "1").astype(np.float64)
+    many = render_png(tmp_path, "s16.png", "--size", "160x90", "--spp", "16", "--aa", "ssaa").astype(np.float64)
+    colours = lambda im: len(np.unique(im[..., :3].reshape(-1, 3), axis=0))
+    assert colours(many) > 2 * colours(one)
+    assert abs(one.mean() - many.mean()) < 3.0
+
+
+def test_thread_count_does_not_change_the_image(tmp_path):
+    a = render_png(tmp_path, "t1.png", "--size", "128x72", "--threads", "1", "--spp", "4")
+    b = render_png(tmp_path, "t2.png", "--size", "128x72", "--threads", "2", "--spp", "4")
+    assert np.array_equal(a, b)
+
+
+def test_exr_output_is_openexr(tmp_path):
+    out = tmp_path / "demo.exr"
+    r = run("render", "-o", str(out), "--size", "32x32")
+    assert r.returncode == 0, r.stderr
+    assert out.read_bytes()[:4] == bytes([0x76, 0x2F, 0x31, 0x01])  # OpenEXR magic number
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--size", "0x10"], ["width", "0"]),
+        (["--size", "100000x100000"], ["width", "100000"]),
+        (["--size", "30000x30000", "--spp", "64"], ["MiB"]),
+        (["--spp", "65"], ["samples", "65"]),
+        (["--spp", "3"], ["square"]),
+        (["--aa", "fxaa"], ["fxaa", "ssaa", "msaa"]),
+        (["--pattern", "poisson"], ["poisson"]),
+        (["--threads", "-1"], ["threads"]),
+        (["--size", "12"], ["WxH"]),
+        (["--bogus"], ["--bogus"]),
+    ],
+)
+def test_bad_options_exit_2_naming_the_input(tmp_path, args, words):
+    r = run("render", "-o", str(tmp_path / "x.png"), *args)
+    assert r.returncode == 2
+    for w in words:
+        assert w in r.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_missing_output_and_unknown_command():
+    r = run("render")
+    assert r.returncode == 2 and "-o" in r.stderr
+    r = run("paint")
+    assert r.returncode == 2 and "paint" in r.stderr
+
+
+def test_unwritable_output_reports_the_path(tmp_path):
+    bad = tmp_path / "no" / "such" / "dir" / "x.png"
+    r = run("render", "-o", str(bad), "--size", "8x8")
+    assert r.returncode == 1
+    assert str(bad) in r.stderr
+
+
+def test_unsupported_extension_is_refused(tmp_path):
+    r = run("render", "-o", str(tmp_path / "x.bmpx"), "--size", "8x8")
+    assert r.returncode != 0 and "x.bmpx" in r.stderr
+
+
+def test_help_and_version():
+    r = run("--help")
+    assert r.returncode == 0 and "render" in r.stdout and "--spp" in r.stdout
+    r = run("--version")
+    assert r.returncode == 0 and r.stdout.startswith("mipraster ")
