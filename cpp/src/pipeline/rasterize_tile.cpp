@@ -17,21 +17,16 @@ inline bool depth_passes(float z, float stored) {
     else return true;
 }
 
-// The vertex colours a draw's triangle needs, loaded once per triangle and tile.
-struct TriangleColors {
-    glm::vec4 v[3];
-};
-
 template <Shading kShading>
-inline glm::vec4 shade(const DrawInputs& draw, const TriangleColors& tc, const SetupTriangle& t,
+inline glm::vec4 shade(const DrawInputs& draw, const VertexValues& colors, const SetupTriangle& t,
                        const glm::dvec3& screen, const ClipWeights* clip_weights) {
     if constexpr (kShading == Shading::constant) {
         return draw.color;
     } else if constexpr (kShading == Shading::flat) {
-        return draw.color * tc.v[0];
+        return draw.color * colors.v[0];
     } else {
         const glm::dvec3 w = kShading == Shading::perspective ? perspective_weights(t, screen) : screen;
-        return draw.color * blend_vertex_values(original_weights(t, w, clip_weights), tc.v[0], tc.v[1], tc.v[2]);
+        return draw.color * colors.interpolate(original_weights(t, w, clip_weights));
     }
 }
 
@@ -49,10 +44,11 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
         if (x0 >= x1 || y0 >= y1) continue;
 
-        TriangleColors tc{};
+        // The vertex colours of the original triangle, once per triangle and tile.
+        VertexValues colors;
         if constexpr (kShading != Shading::constant) {
             const glm::uvec3 tri = draw.triangles[t.triangle];
-            for (int i = 0; i < 3; ++i) tc.v[i] = draw.vertex_colors ? draw.vertex_colors[tri[i]] : glm::vec4(1.0f);
+            colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
         }
 
         // Edge offsets of each sample from its pixel's corner: a·ox + b·oy.
@@ -112,7 +108,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     ++counters.shader_invocations;
                     glm::vec4 color;
                     if constexpr (kShading == Shading::constant || kShading == Shading::flat) {
-                        color = shade<kShading>(draw, tc, t, glm::dvec3(0.0), batch.clip_weights);
+                        color = shade<kShading>(draw, colors, t, glm::dvec3(0.0), batch.clip_weights);
                     } else {
                         const std::int64_t half = kStep / 2;
                         std::int64_t c0 = p0 + (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * half;
@@ -124,7 +120,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             c1 = p1 + off1[s];
                             c2 = p2 + off2[s];
                         }
-                        color = shade<kShading>(draw, tc, t, screen_weights(t, c0, c1, c2), batch.clip_weights);
+                        color = shade<kShading>(draw, colors, t, screen_weights(t, c0, c1, c2), batch.clip_weights);
                     }
                     for (std::uint64_t m = passed; m; m &= m - 1)
                         blend_into<kBlend>(&fb.color[4 * (base + __builtin_ctzll(m))], color);
@@ -145,7 +141,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         }
                         ++counters.samples_passed;
                         ++counters.shader_invocations;
-                        blend_into<kBlend>(&fb.color[4 * (base + s)], shade<kShading>(draw, tc, t, l, batch.clip_weights));
+                        blend_into<kBlend>(&fb.color[4 * (base + s)], shade<kShading>(draw, colors, t, l, batch.clip_weights));
                     }
                 }
             }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 
+#include <glm/common.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -37,16 +38,22 @@ inline glm::dvec3 original_weights(const SetupTriangle& t, const glm::dvec3& w, 
     return w.x * glm::dvec3(c[0]) + w.y * glm::dvec3(c[1]) + w.z * glm::dvec3(c[2]);
 }
 
-/// Σ w_i·v_i, clamped to the per-component range of the v_i so rounding never leaves it.
-inline glm::vec4 blend_vertex_values(const glm::dvec3& w, const glm::vec4& v0, const glm::vec4& v1,
-                                     const glm::vec4& v2) {
-    glm::vec4 r;
-    for (int c = 0; c < 4; ++c) {
-        const double x = w.x * v0[c] + w.y * v1[c] + w.z * v2[c];
-        const float lo = std::min({v0[c], v1[c], v2[c]}), hi = std::max({v0[c], v1[c], v2[c]});
-        r[c] = std::clamp(static_cast<float>(x), lo, hi);
+/// The values of an attribute at a triangle's three vertices, with their per-component range.
+struct VertexValues {
+    glm::vec4 v[3];
+    glm::vec4 lo, hi;
+
+    VertexValues() = default;
+    VertexValues(const glm::vec4& a, const glm::vec4& b, const glm::vec4& c)
+        : v{a, b, c}, lo(glm::min(a, glm::min(b, c))), hi(glm::max(a, glm::max(b, c))) {}
+
+    /// Σ w_i·v_i, clamped to the vertex values' range so rounding never leaves it.
+    glm::vec4 interpolate(const glm::dvec3& w) const {
+        glm::vec4 r;
+        for (int c = 0; c < 4; ++c)
+            r[c] = std::clamp(static_cast<float>(w.x * v[0][c] + w.y * v[1][c] + w.z * v[2][c]), lo[c], hi[c]);
+        return r;
     }
-    return r;
-}
+};
 
 }  // namespace mipraster

@@ -38,7 +38,7 @@ struct TileTarget {
 /// Per-draw inputs of the kernel.
 struct DrawInputs {
     const glm::uvec3* triangles;
-    const glm::vec4* vertex_colors;  ///< null when the mesh has none
+    const glm::vec4* vertex_colors;  ///< null when the mesh has none (then shading is constant)
     glm::vec4 color;
     bool depth_write;
 };
