@@ -1,0 +1,149 @@
+#pragma once
+// Small helpers shared by the C++ tests: cameras and model matrices that make test geometry exact,
+// render wrappers and framebuffer accessors. Expected values come from oracle.hpp, never from here.
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "mipraster/pipeline/draw.hpp"
+#include "mipraster/pipeline/framebuffer.hpp"
+#include "mipraster/pipeline/renderer.hpp"
+#include "mipraster/pipeline/sample_pattern.hpp"
+#include "mipraster/scene/camera.hpp"
+#include "mipraster/scene/mesh.hpp"
+#include "oracle.hpp"
+
+namespace helpers {
+
+namespace mr = mipraster;
+
+/// Identity view and projection, OpenGL convention: clip (x, y, z, 1) is NDC directly.
+inline mr::Camera identity_camera() {
+    return mr::Camera::from_matrices(glm::dmat4(1.0), glm::dmat4(1.0), mr::DepthConvention::opengl);
+}
+
+/// Model matrix from (X, Y, z) in 1/256 px screen units (y down) to NDC of a W×H viewport:
+/// x = X/(128·W) − 1, y = 1 − Y/(128·H). For power-of-two W and H every step is exact in double,
+/// so the library's screen position ·256 is X itself and snapping rounds X.
+inline glm::dmat4 fixed_to_ndc(int width, int height) {
+    glm::dmat4 m(1.0);
+    m[0][0] = 1.0 / (128.0 * width);
+    m[3][0] = -1.0;
+    m[1][1] = -1.0 / (128.0 * height);
+    m[3][1] = 1.0;
+    return m;
+}
+
+/// The snapped position of a vertex given in 1/256 px units through fixed_to_ndc.
+inline oracle::Fixed2 snap_fixed(const glm::vec3& p) {
+    return {oracle::snap(static_cast<double>(p.x)), oracle::snap(static_cast<double>(p.y))};
+}
+
+inline std::array<oracle::Fixed2, 3> snapped_triangle(const mr::Mesh& mesh, std::size_t t) {
+    const glm::uvec3 tri = mesh.triangles[t];
+    return {snap_fixed(mesh.positions[tri[0]]), snap_fixed(mesh.positions[tri[1]]), snap_fixed(mesh.positions[tri[2]])};
+}
+
+inline mr::RenderSettings settings(int width, int height, int samples = 1,
+                                   mr::PatternKind pattern = mr::PatternKind::automatic) {
+    mr::RenderSettings s;
+    s.width = width;
+    s.height = height;
+    s.samples = samples;
+    s.pattern = pattern;
+    s.threads = 2;
+    s.keep_samples = true;
+    return s;
+}
+
+inline mr::DrawState no_depth(mr::BlendMode blend = mr::BlendMode::replace) {
+    mr::DrawState st;
+    st.depth_test = false;
+    st.depth_write = false;
+    st.blend = blend;
+    return st;
+}
+
+inline mr::Draw make_draw(const mr::Mesh& mesh, const glm::dmat4& model, const mr::DrawState& state,
+                          glm::vec4 color = glm::vec4(1.0f)) {
+    mr::Draw d;
+    d.mesh = &mesh;
+    d.model = model;
+    d.color = color;
+    d.state = state;
+    return d;
+}
+
+/// The pattern the render used, as the oracle's type.
+inline oracle::Pattern to_oracle(const mr::SamplePattern& p) {
+    oracle::Pattern o;
+    for (int s = 0; s < p.count(); ++s) {
+        o.x.push_back(p.x[s]);
+        o.y.push_back(p.y[s]);
+    }
+    return o;
+}
+
+/// Whether two patterns hold the same set of offsets (in any order).
+inline bool same_offsets(const oracle::Pattern& a, const oracle::Pattern& b) {
+    if (a.count() != b.count()) return false;
+    std::vector<std::pair<int, int>> pa, pb;
+    for (int s = 0; s < a.count(); ++s) pa.push_back({a.x[s], a.y[s]});
+    for (int s = 0; s < b.count(); ++s) pb.push_back({b.x[s], b.y[s]});
+    std::sort(pa.begin(), pa.end());
+    std::sort(pb.begin(), pb.end());
+    return pa == pb;
+}
+
+inline float sample_channel(const mr::Framebuffer& fb, int x, int y, int s, int c) {
+    return fb.color[4 * fb.sample_index(x, y, s) + static_cast<std::size_t>(c)];
+}
+
+inline glm::vec4 sample_color(const mr::Framebuffer& fb, int x, int y, int s) {
+    const float* p = &fb.color[4 * fb.sample_index(x, y, s)];
+    return {p[0], p[1], p[2], p[3]};
+}
+
+/// Compares channel c of every sample with an expected value per sample; reports the first few
+/// differences and their number.
+inline ::testing::AssertionResult samples_equal(const mr::Framebuffer& fb, const std::vector<float>& expected, int c,
+                                                const std::string& what) {
+    const int W = fb.width, H = fb.height, S = fb.samples;
+    if (expected.size() != static_cast<std::size_t>(W) * H * S)
+        return ::testing::AssertionFailure() << what << ": expected array has the wrong size";
+    std::size_t bad = 0;
+    std::ostringstream first;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x)
+            for (int s = 0; s < S; ++s) {
+                const std::size_t i = fb.sample_index(x, y, s);
+                const float got = fb.color[4 * i + c];
+                if (got != expected[i]) {
+                    if (bad < 8)
+                        first << "\n  pixel (" << x << ", " << y << ") sample " << s << ": got " << got
+                              << ", expected " << expected[i];
+                    ++bad;
+                }
+            }
+    if (bad == 0) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << what << ": " << bad << " of " << static_cast<std::size_t>(W) * H * S
+                                         << " samples differ" << first.str();
+}
+
+/// Triangle count helper for meshes built in tests.
+inline void add_triangle(mr::Mesh& m, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    m.triangles.push_back(glm::uvec3(a, b, c));
+}
+
+}  // namespace helpers

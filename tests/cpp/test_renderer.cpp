@@ -1,0 +1,283 @@
+// The renderer as a whole: bit-identical output for any thread count (DESIGN.md §2.8), bad input
+// rejected with std::invalid_argument naming it (§7) before anything large is allocated,
+// non-finite triangles dropped and counted, and an empty draw list rendering the clear colour.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "helpers.hpp"
+#include "oracle.hpp"
+
+namespace {
+
+namespace mr = mipraster;
+using namespace helpers;
+
+// ---------------------------------------------------------------------------------------------
+// Determinism
+// ---------------------------------------------------------------------------------------------
+
+/// `n` random triangles of size about `size` in the box [−2, 2]×[−1.5, 1.5]×[−2, 6] (the camera is
+/// at z = 4, so some cross the near plane or lie behind it), with premultiplied vertex colours.
+mr::Mesh random_triangles(std::size_t n, double size, std::uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    mr::Mesh m;
+    for (std::size_t t = 0; t < n; ++t) {
+        const glm::dvec3 c(-2.0 + 4.0 * u(rng), -1.5 + 3.0 * u(rng), -2.0 + 8.0 * u(rng));
+        for (int i = 0; i < 3; ++i) {
+            const glm::dvec3 p = c + size * glm::dvec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+            m.positions.push_back(glm::vec3(p));
+            const float a = static_cast<float>(0.2 + 0.8 * u(rng));
+            m.colors.push_back(glm::vec4(a * float(u(rng)), a * float(u(rng)), a * float(u(rng)), a));
+        }
+        add_triangle(m, static_cast<std::uint32_t>(3 * t), static_cast<std::uint32_t>(3 * t + 1),
+                     static_cast<std::uint32_t>(3 * t + 2));
+    }
+    return m;
+}
+
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+}
+
+TEST(Renderer, OneTwoAndFourThreadsGiveBitIdenticalColourAndDepthForEveryBlendModeSsaaAndMsaa) {
+    const int W = 160, H = 120;
+    const mr::Camera cam = mr::Camera::look_at_perspective({0.3, 1.0, 4.0}, {0, 0, 0}, {0, 1, 0}, 1.0, double(W) / H, 0.05);
+    // A few thousand large overlapping triangles, then 40,000 small ones: more than 4096 per
+    // thread, so the setup splits them into a different number of chunks for each thread count.
+    const mr::Mesh large = random_triangles(3000, 1.5, 1), small = random_triangles(40000, 0.15, 2);
+    for (mr::BlendMode blend : {mr::BlendMode::replace, mr::BlendMode::add, mr::BlendMode::over}) {
+        for (int mode = 0; mode < 4; ++mode) {
+            // SSAA and MSAA at 4 samples, MSAA at 16, and one sample per pixel.
+            const mr::AntiAliasing aa = mode == 1 || mode == 2 ? mr::AntiAliasing::msaa : mr::AntiAliasing::ssaa;
+            const int S = mode == 2 ? 16 : mode == 3 ? 1 : 4;
+            SCOPED_TRACE(mr::to_string(blend) + ", " + mr::to_string(aa) + ", " + std::to_string(S) + " samples");
+            mr::DrawState a;  // depth test and write, perspective-correct colours
+            a.blend = blend;
+            mr::DrawState b = a;
+            b.interpolation = mr::Interpolation::screen;
+            b.cull = mr::CullMode::back;
+            const std::vector<mr::Draw> draws = {make_draw(large, glm::dmat4(1.0), a),
+                                                 make_draw(small, glm::dmat4(1.0), b, glm::vec4(0.9f, 0.8f, 1.0f, 1.0f))};
+            mr::RenderResult ref;
+            for (int threads : {1, 2, 4}) {
+                auto s = settings(W, H, S);
+                s.anti_aliasing = aa;
+                s.threads = threads;
+                s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+                mr::RenderResult r = mr::render(draws, cam, s);
+                EXPECT_EQ(r.stats.threads, threads);
+                if (threads == 1) {
+                    ASSERT_TRUE(r.framebuffer.has_depth());
+                    EXPECT_GT(r.stats.triangles_clipped, 0u);
+                    EXPECT_GT(r.stats.samples_passed, 20000u * S);
+                    ref = std::move(r);
+                    continue;
+                }
+                EXPECT_TRUE(same_bits(r.color.pixels, ref.color.pixels)) << threads << " threads: resolved colour differs";
+                EXPECT_TRUE(same_bits(r.framebuffer.color, ref.framebuffer.color)) << threads << " threads: samples differ";
+                EXPECT_TRUE(same_bits(r.framebuffer.depth, ref.framebuffer.depth)) << threads << " threads: depth differs";
+                EXPECT_EQ(r.stats.triangles_in, ref.stats.triangles_in);
+                EXPECT_EQ(r.stats.triangles_clipped, ref.stats.triangles_clipped);
+                EXPECT_EQ(r.stats.triangles_outside, ref.stats.triangles_outside);
+                EXPECT_EQ(r.stats.triangles_backface, ref.stats.triangles_backface);
+                EXPECT_EQ(r.stats.triangles_degenerate, ref.stats.triangles_degenerate);
+                EXPECT_EQ(r.stats.triangles_rasterized, ref.stats.triangles_rasterized);
+                EXPECT_EQ(r.stats.samples_covered, ref.stats.samples_covered);
+                EXPECT_EQ(r.stats.samples_passed, ref.stats.samples_passed);
+                EXPECT_EQ(r.stats.shader_invocations, ref.stats.shader_invocations);
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input
+// ---------------------------------------------------------------------------------------------
+
+mr::Mesh small_mesh() {
+    mr::Mesh m;
+    for (int i = 0; i < 10; ++i) m.positions.push_back(glm::vec3(0.1f * i - 0.5f, 0.05f * (i % 3), 0.0f));
+    for (std::uint32_t i = 0; i + 2 < 10; ++i) add_triangle(m, i, i + 1, i + 2);
+    return m;
+}
+
+/// Runs the render and returns the std::invalid_argument message ("" and a failure otherwise).
+std::string invalid_argument_message(const std::vector<mr::Draw>& draws, const mr::RenderSettings& s,
+                                     const mr::Camera& cam = identity_camera()) {
+    try {
+        mr::render(draws, cam, s);
+    } catch (const std::invalid_argument& e) {
+        return e.what();
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "threw something other than std::invalid_argument: " << e.what();
+        return "";
+    }
+    ADD_FAILURE() << "did not throw";
+    return "";
+}
+
+#define EXPECT_MESSAGE_HAS(message, part) \
+    EXPECT_NE((message).find(part), std::string::npos) << "message: \"" << (message) << "\" lacks \"" << (part) << "\""
+
+TEST(Renderer, NonFiniteVertexPositionThrowsNamingTheVertex) {
+    for (float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                      -std::numeric_limits<float>::infinity()}) {
+        mr::Mesh m = small_mesh();
+        m.positions[7].y = bad;
+        const std::string msg = invalid_argument_message({make_draw(m, glm::dmat4(1.0), no_depth())}, settings(8, 8));
+        EXPECT_MESSAGE_HAS(msg, "positions[7]");
+        EXPECT_MESSAGE_HAS(msg, "draws[0]");
+    }
+}
+
+TEST(Renderer, IndexOutOfRangeThrowsNamingTheTriangle) {
+    mr::Mesh m = small_mesh();
+    m.triangles[5] = glm::uvec3(0, 10, 2);  // 10 vertices: index 10 is one past the end
+    const mr::Mesh ok = small_mesh();
+    const std::string msg = invalid_argument_message(
+        {make_draw(ok, glm::dmat4(1.0), no_depth()), make_draw(m, glm::dmat4(1.0), no_depth())}, settings(8, 8));
+    EXPECT_MESSAGE_HAS(msg, "triangles[5]");
+    EXPECT_MESSAGE_HAS(msg, "draws[1]");
+}
+
+TEST(Renderer, ColourArrayOfTheWrongSizeThrowsNamingIt) {
+    mr::Mesh m = small_mesh();
+    m.colors.assign(9, glm::vec4(1.0f));
+    const std::string msg = invalid_argument_message({make_draw(m, glm::dmat4(1.0), no_depth())}, settings(8, 8));
+    EXPECT_MESSAGE_HAS(msg, "colors");
+    EXPECT_MESSAGE_HAS(msg, "9");
+    EXPECT_MESSAGE_HAS(msg, "10");
+}
+
+TEST(Renderer, NonFiniteVertexColourOrDrawColourThrowsNamingIt) {
+    mr::Mesh m = small_mesh();
+    m.colors.assign(10, glm::vec4(1.0f));
+    m.colors[3].a = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_MESSAGE_HAS(invalid_argument_message({make_draw(m, glm::dmat4(1.0), no_depth())}, settings(8, 8)), "colors[3]");
+    const mr::Mesh ok = small_mesh();
+    const std::string msg = invalid_argument_message(
+        {make_draw(ok, glm::dmat4(1.0), no_depth(), glm::vec4(1, std::numeric_limits<float>::infinity(), 1, 1))},
+        settings(8, 8));
+    EXPECT_MESSAGE_HAS(msg, "color");
+    EXPECT_MESSAGE_HAS(msg, "draws[0]");
+}
+
+TEST(Renderer, NullMeshThrowsNamingTheDraw) {
+    const mr::Mesh ok = small_mesh();
+    mr::Draw null_draw = make_draw(ok, glm::dmat4(1.0), no_depth());
+    null_draw.mesh = nullptr;
+    const std::string msg =
+        invalid_argument_message({make_draw(ok, glm::dmat4(1.0), no_depth()), null_draw}, settings(8, 8));
+    EXPECT_MESSAGE_HAS(msg, "draws[1]");
+    EXPECT_MESSAGE_HAS(msg, "mesh");
+}
+
+TEST(Renderer, BadResolutionThrowsNamingTheDimensionBeforeAllocating) {
+    const mr::Mesh ok = small_mesh();
+    const std::vector<mr::Draw> draws = {make_draw(ok, glm::dmat4(1.0), mr::DrawState{})};
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, settings(0, 8)), "width");
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, settings(-3, 8)), "width");
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, settings(8, 0)), "height");
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, settings(8, -1)), "height");
+    // Absurd: 100000 × 100000 exceeds the largest dimension; the message names the limit.
+    const std::string big = invalid_argument_message(draws, settings(100000, 100000));
+    EXPECT_MESSAGE_HAS(big, "width");
+    EXPECT_MESSAGE_HAS(big, "32768");
+    // Within the dimension limit but far beyond the memory limit (32768² × 64 samples × 20 bytes
+    // = 1.25 TiB): refused with the memory it would need, not a std::bad_alloc or a crash.
+    const std::string huge = invalid_argument_message(draws, settings(32768, 32768, 64));
+    EXPECT_MESSAGE_HAS(huge, "MiB");
+}
+
+TEST(Renderer, BadSampleCountsAndPatternsThrowNamingThem) {
+    const mr::Mesh ok = small_mesh();
+    const std::vector<mr::Draw> draws = {make_draw(ok, glm::dmat4(1.0), no_depth())};
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, settings(8, 8, 0)), "samples");
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, settings(8, 8, 65)), "samples");
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, settings(8, 8, 9, mr::PatternKind::rotated)), "rotated");
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, settings(8, 8, 4, mr::PatternKind::center)), "center");
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, settings(8, 8, 8, mr::PatternKind::grid)), "grid");
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, settings(8, 8, 12, mr::PatternKind::stratified)), "stratified");
+    auto s = settings(8, 8);
+    s.threads = -1;
+    EXPECT_MESSAGE_HAS(invalid_argument_message(draws, s), "threads");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Non-finite transforms and empty input
+// ---------------------------------------------------------------------------------------------
+
+TEST(Renderer, TrianglesMadeNonFiniteByTheModelMatrixAreDroppedCountedAndDrawNothing) {
+    const int W = 16, H = 16;
+    mr::Mesh big;
+    big.positions = {{-4096, -4096, 0}, {8192, -4096, 0}, {-4096, 8192, 0}, {100, 100, 0}, {3000, 200, 0}, {900, 3500, 0}};
+    add_triangle(big, 0, 1, 2);
+    add_triangle(big, 3, 4, 5);
+    for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+        glm::dmat4 model = fixed_to_ndc(W, H);
+        model[0][0] = bad;
+        const mr::RenderResult r =
+            mr::render({make_draw(big, model, mr::DrawState{})}, identity_camera(), settings(W, H, 4));
+        EXPECT_EQ(r.stats.triangles_in, 2u);
+        EXPECT_EQ(r.stats.triangles_nonfinite, 2u);
+        EXPECT_EQ(r.stats.triangles_rasterized, 0u);
+        EXPECT_EQ(r.stats.samples_covered, 0u);
+        EXPECT_TRUE(samples_equal(r.framebuffer, std::vector<float>(W * H * 4, 0.0f), 0, "red"));
+        EXPECT_TRUE(samples_equal(r.framebuffer, std::vector<float>(W * H * 4, 0.0f), 3, "alpha"));
+    }
+    // Next to a valid draw, only the bad one is dropped; the valid one draws what the oracle says.
+    glm::dmat4 nan_model = fixed_to_ndc(W, H);
+    nan_model[3][1] = std::numeric_limits<double>::quiet_NaN();
+    mr::Mesh one;
+    one.positions = {{100, 100, 0}, {3000, 200, 0}, {900, 3500, 0}};
+    add_triangle(one, 0, 1, 2);
+    const mr::RenderResult r = mr::render({make_draw(big, nan_model, no_depth(mr::BlendMode::add)),
+                                           make_draw(one, fixed_to_ndc(W, H), no_depth(mr::BlendMode::add))},
+                                          identity_camera(), settings(W, H, 4, mr::PatternKind::rotated));
+    EXPECT_EQ(r.stats.triangles_nonfinite, 2u);
+    EXPECT_EQ(r.stats.triangles_rasterized, 1u);
+    std::vector<int> counts(W * H * 4, 0);
+    oracle::accumulate_coverage(snapped_triangle(one, 0), W, H, oracle::rotated_pattern(), counts);
+    EXPECT_TRUE(samples_equal(r.framebuffer, std::vector<float>(counts.begin(), counts.end()), 0, "coverage"));
+}
+
+TEST(Renderer, ZeroThreadsMeansEveryHardwareThread) {
+    auto s = settings(8, 8);
+    s.threads = 0;
+    const mr::RenderResult r = mr::render({}, identity_camera(), s);
+    const unsigned hw = std::thread::hardware_concurrency();
+    EXPECT_EQ(r.stats.threads, hw == 0 ? 1 : static_cast<int>(hw));
+}
+
+TEST(Renderer, EmptyDrawListRendersTheClearColour) {
+    for (int S : {1, 4, 16}) {
+        auto s = settings(7, 5, S);
+        s.clear_color = glm::vec4(0.125f, 0.25f, 0.5f, 0.75f);
+        const mr::RenderResult r = mr::render({}, identity_camera(), s);
+        ASSERT_EQ(r.color.width, 7);
+        ASSERT_EQ(r.color.height, 5);
+        ASSERT_EQ(r.color.channels, 4);
+        for (int y = 0; y < 5; ++y)
+            for (int x = 0; x < 7; ++x)
+                for (int c = 0; c < 4; ++c) EXPECT_EQ(r.color.at(x, y, c), s.clear_color[c]);
+        EXPECT_FALSE(r.framebuffer.has_depth());
+        EXPECT_EQ(r.stats.triangles_in, 0u);
+        EXPECT_EQ(r.stats.samples_covered, 0u);
+        // A draw with an empty mesh is the same.
+        const mr::Mesh empty;
+        const mr::RenderResult e = mr::render({make_draw(empty, glm::dmat4(1.0), no_depth())}, identity_camera(), s);
+        EXPECT_EQ(e.color.pixels, r.color.pixels);
+    }
+}
+
+}  // namespace
