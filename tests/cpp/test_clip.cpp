@@ -141,7 +141,7 @@ void expect_clipped_coverage_matches_ray_cast(const mr::Camera& cam, double near
     if (cull != mr::CullMode::none) {
         EXPECT_GT(culled, 4);
         EXPECT_GT(kept, 4);
-        EXPECT_GE(backface, static_cast<std::uint64_t>(culled));
+        EXPECT_EQ(backface, static_cast<std::uint64_t>(culled)) << "each culled triangle counts once";
     }
 }
 
@@ -457,6 +457,27 @@ TEST(Clip, HugeQuadsSplitAlongADiagonalThroughTheViewportStayWatertightAfterGuar
 
 TEST(Clip, HugeQuadsStayWatertightInTheLargestViewport) {
     expect_huge_quads_watertight(32768, 8, 1, 6, 100);
+}
+
+TEST(Clip, StatsCountASubmittedTriangleOnceWhateverItsClippedPieces) {
+    // A floor triangle crossing the near plane clips into a quadrilateral (two pieces); culled
+    // as a front face, it is one culled triangle, not two.
+    const mr::Camera cam = mr::Camera::look_at_perspective({0, 1, 0}, {0, 1, -1}, {0, 1, 0}, 1.0, 1.0, 0.1);
+    mr::Mesh m;
+    m.positions = {{-5, 0, -10}, {0, 0, 2}, {5, 0, -10}};
+    add_triangle(m, 0, 1, 2);
+    for (mr::CullMode cull : {mr::CullMode::front, mr::CullMode::back}) {
+        mr::DrawState st = no_depth();
+        st.cull = cull;
+        const mr::RenderResult r = mr::render({make_draw(m, glm::dmat4(1.0), st)}, cam, settings(64, 64));
+        EXPECT_EQ(r.stats.triangles_in, 1u);
+        EXPECT_EQ(r.stats.triangles_clipped, 1u);
+        // (p1 − p0) × (p2 − p0) = (0, 120, 0) points up at the camera: a front face.
+        const bool culled = cull == mr::CullMode::front;
+        EXPECT_EQ(r.stats.triangles_backface, culled ? 1u : 0u) << mr::to_string(cull);
+        EXPECT_EQ(r.stats.triangles_rasterized, culled ? 0u : 2u) << mr::to_string(cull);
+        EXPECT_EQ(r.stats.samples_covered > 0, !culled) << mr::to_string(cull);
+    }
 }
 
 }  // namespace

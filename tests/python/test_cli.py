@@ -72,7 +72,7 @@ def test_exr_output_is_openexr(tmp_path):
         (["--size", "100000x100000"], ["width", "100000"]),
         (["--size", "30000x30000", "--spp", "64"], ["MiB"]),
         (["--spp", "65"], ["samples", "65"]),
-        (["--spp", "3"], ["square"]),
+        (["--spp", "8", "--pattern", "rotated"], ["rotated", "4", "8"]),
         (["--aa", "fxaa"], ["fxaa", "ssaa", "msaa"]),
         (["--pattern", "poisson"], ["poisson"]),
         (["--threads", "-1"], ["threads"]),

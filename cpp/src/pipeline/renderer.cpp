@@ -97,15 +97,26 @@ void setup_chunk(const ChunkRange& range, const Draw& draw, const ClipSpaceVerti
             case ClipOutcome::clipped: {
                 ++clipped;
                 // Fan-triangulate the clipped polygon; each piece keeps its original-triangle weights.
+                SetupCounters pieces;
+                bool any = false;
                 for (int i = 1; i + 1 < polygon.count; ++i) {
                     const ClipVertex* v[3] = {&polygon.vertices[0], &polygon.vertices[i], &polygon.vertices[i + 1]};
                     st.clip_index = static_cast<std::int32_t>(chunk.clip_weights.size());
                     if (setup_triangle({v[0]->position, v[1]->position, v[2]->position}, viewport, draw.state.cull, st,
-                                       counters)) {
+                                       pieces)) {
+                        any = true;
                         chunk.triangles.push_back(st);
                         chunk.clip_weights.push_back(
                             {glm::vec3(v[0]->weights), glm::vec3(v[1]->weights), glm::vec3(v[2]->weights)});
                     }
+                }
+                // The counters count submitted triangles: a clipped one that drew nothing counts
+                // once, under the first reason that applies to its pieces.
+                if (!any) {
+                    if (pieces.culled_backface) ++counters.culled_backface;
+                    else if (pieces.dropped_nonfinite) ++counters.dropped_nonfinite;
+                    else if (pieces.culled_outside) ++counters.culled_outside;
+                    else ++counters.culled_degenerate;
                 }
                 break;
             }

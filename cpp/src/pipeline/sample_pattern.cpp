@@ -9,9 +9,12 @@ namespace mipraster {
 
 namespace {
 
-int exact_square_root(int n) {
-    const int r = static_cast<int>(std::lround(std::sqrt(static_cast<double>(n))));
-    return r * r == n ? r : 0;
+// The most square factorization samples = columns × rows with columns ≥ rows.
+int grid_rows(int samples) {
+    int rows = 1;
+    for (int r = 1; r * r <= samples; ++r)
+        if (samples % r == 0) rows = r;
+    return rows;
 }
 
 // splitmix64: a small, well-mixed generator so a seed gives the same pattern everywhere.
@@ -47,7 +50,6 @@ SamplePattern make_sample_pattern(PatternKind kind, int samples, std::uint64_t s
     if (samples < 1 || samples > kMaxSamples)
         throw std::invalid_argument("samples per pixel: expected 1 to " + std::to_string(kMaxSamples) + ", got " +
                                     std::to_string(samples));
-    const int n = exact_square_root(samples);
     if (kind == PatternKind::automatic)
         kind = samples == 1 ? PatternKind::center : samples == 4 ? PatternKind::rotated : PatternKind::grid;
     SamplePattern p;
@@ -73,21 +75,19 @@ SamplePattern make_sample_pattern(PatternKind kind, int samples, std::uint64_t s
             break;
         case PatternKind::grid:
         case PatternKind::stratified: {
-            if (n == 0)
-                throw std::invalid_argument("pattern '" + to_string(kind) +
-                                            "' needs a square sample count (1, 4, 9, 16, 25, 36, 49, 64); got samples=" +
-                                            std::to_string(samples));
+            const int rows = grid_rows(samples), cols = samples / rows;
             std::uint64_t state = seed;
-            for (int b = 0; b < n; ++b)
-                for (int a = 0; a < n; ++a) {
+            for (int b = 0; b < rows; ++b)
+                for (int a = 0; a < cols; ++a) {
                     if (kind == PatternKind::grid) {
-                        // (a+½)/N·256 rounded half-up; exact when N divides 128.
-                        add(static_cast<std::int32_t>((256 * (2 * a + 1) + n) / (2 * n)),
-                            static_cast<std::int32_t>((256 * (2 * b + 1) + n) / (2 * n)));
+                        // ((a+½)/cols, (b+½)/rows)·256 rounded to nearest, ties up; exact when the
+                        // count divides 128.
+                        add(static_cast<std::int32_t>((256 * (2 * a + 1) + cols) / (2 * cols)),
+                            static_cast<std::int32_t>((256 * (2 * b + 1) + rows) / (2 * rows)));
                     } else {
-                        // Stratum [a/N, (a+1)/N) on the 1/256 grid: offsets lo … hi−1.
-                        const int lo_x = 256 * a / n, hi_x = 256 * (a + 1) / n;
-                        const int lo_y = 256 * b / n, hi_y = 256 * (b + 1) / n;
+                        // Stratum [a/cols, (a+1)/cols) × [b/rows, (b+1)/rows) on the 1/256 grid.
+                        const int lo_x = 256 * a / cols, hi_x = 256 * (a + 1) / cols;
+                        const int lo_y = 256 * b / rows, hi_y = 256 * (b + 1) / rows;
                         add(lo_x + static_cast<std::int32_t>(splitmix64(state) % static_cast<std::uint64_t>(hi_x - lo_x)),
                             lo_y + static_cast<std::int32_t>(splitmix64(state) % static_cast<std::uint64_t>(hi_y - lo_y)));
                     }

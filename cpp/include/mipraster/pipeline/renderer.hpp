@@ -36,7 +36,9 @@ struct RenderSettings {
     std::string to_string() const;
 };
 
-/// Counts and times of one render. Counts do not depend on the thread count.
+/// Counts and times of one render. Counts do not depend on the thread count. The triangle
+/// counters count submitted triangles (a clipped triangle none of whose pieces drew is counted
+/// once), except triangles_rasterized, which counts the pieces sent to the rasterizer.
 struct RenderStats {
     std::uint64_t triangles_in = 0;        ///< submitted triangles
     std::uint64_t triangles_clipped = 0;   ///< crossed a clip plane and were clipped

@@ -6,12 +6,14 @@
 
 namespace mipraster {
 
+/// Sample patterns. grid and stratified lay out S samples as C columns × R rows, the most
+/// square factorization of S with C ≥ R (N×N for square S; 8 → 4×2; a prime S → S×1).
 enum class PatternKind {
-    automatic,   ///< center for 1 sample, rotated for 4, grid for other squares
+    automatic,   ///< center for 1 sample, rotated for 4, grid otherwise
     center,      ///< 1 sample at (½, ½)
-    grid,        ///< N×N at ((a+½)/N, (b+½)/N), rounded to 1/256
+    grid,        ///< C×R at ((a+½)/C, (b+½)/R), rounded to 1/256
     rotated,     ///< the standard rotated 4× pattern
-    stratified,  ///< N×N strata, one seeded random position in each
+    stratified,  ///< C×R strata, one seeded random position in each
 };
 
 std::string to_string(PatternKind kind);
@@ -27,8 +29,8 @@ struct SamplePattern {
     std::string to_string() const;
 };
 
-/// Builds the pattern of `samples` samples (1…64). grid and stratified need a square count,
-/// rotated needs 4, center needs 1; otherwise std::invalid_argument names what was expected.
+/// Builds the pattern of `samples` samples (1…64). rotated needs 4 and center 1; otherwise
+/// std::invalid_argument names what was expected.
 SamplePattern make_sample_pattern(PatternKind kind, int samples, std::uint64_t seed = 0);
 
 }  // namespace mipraster
