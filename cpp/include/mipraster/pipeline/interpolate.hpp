@@ -27,7 +27,7 @@ inline float sample_depth(const SetupTriangle& t, const glm::dvec3& l) {
 /// sum to 1, so interpolated values stay within the vertex values (up to rounding).
 inline glm::dvec3 perspective_weights(const SetupTriangle& t, const glm::dvec3& l) {
     const glm::dvec3 q(l.x * t.inv_w[0], l.y * t.inv_w[1], l.z * t.inv_w[2]);
-    return q / (q.x + q.y + q.z);
+    return q * (1.0 / (q.x + q.y + q.z));
 }
 
 /// Maps weights of the setup triangle's vertices to weights of the original triangle's vertices
