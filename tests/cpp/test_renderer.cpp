@@ -193,10 +193,12 @@ TEST(Renderer, BadResolutionThrowsNamingTheDimensionBeforeAllocating) {
     const std::string big = invalid_argument_message(draws, settings(100000, 100000));
     EXPECT_MESSAGE_HAS(big, "width");
     EXPECT_MESSAGE_HAS(big, "32768");
+    // ... and the memory it would need: 10^10 pixels × (16 B colour + 4 B depth) = 190734 MiB.
+    EXPECT_MESSAGE_HAS(big, "190734 MiB");
     // Within the dimension limit but far beyond the memory limit (32768² × 64 samples × 20 bytes
     // = 1.25 TiB): refused with the memory it would need, not a std::bad_alloc or a crash.
     const std::string huge = invalid_argument_message(draws, settings(32768, 32768, 64));
-    EXPECT_MESSAGE_HAS(huge, "MiB");
+    EXPECT_MESSAGE_HAS(huge, "1310720 MiB");
 }
 
 TEST(Renderer, BadSampleCountsAndPatternsThrowNamingThem) {

@@ -13,10 +13,15 @@ std::uint64_t framebuffer_bytes(int width, int height, int samples, bool with_de
 }
 
 void validate_framebuffer_size(int width, int height, int samples, bool with_depth) {
-    auto dim = [](const char* name, int v) {
-        if (v < 1 || v > kMaxDimension)
-            throw std::invalid_argument(std::string(name) + ": expected 1 to " + std::to_string(kMaxDimension) +
-                                        " pixels, got " + std::to_string(v));
+    auto dim = [&](const char* name, int v) {
+        if (v >= 1 && v <= kMaxDimension) return;
+        std::string message = std::string(name) + ": expected 1 to " + std::to_string(kMaxDimension) +
+                              " pixels, got " + std::to_string(v);
+        if (width > 0 && height > 0 && samples > 0)
+            message += " (a " + std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(samples) +
+                       " framebuffer would need " + std::to_string(framebuffer_bytes(width, height, samples, with_depth) >> 20) +
+                       " MiB)";
+        throw std::invalid_argument(message);
     };
     dim("width", width);
     dim("height", height);
