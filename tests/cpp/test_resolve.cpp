@@ -13,7 +13,6 @@
 
 #include "helpers.hpp"
 #include "mipraster/core/colour.hpp"
-#include "mipraster/core/thread_pool.hpp"
 #include "mipraster/pipeline/resolve.hpp"
 #include "oracle.hpp"
 
@@ -78,7 +77,6 @@ double mean_tolerance(const std::vector<double>& xs) {
 TEST(Resolve, BoxResolveIsTheMeanOfEachPixelsSamplesForRandomData) {
     std::mt19937_64 rng(6);
     std::uniform_real_distribution<float> u(-1.0f, 2.0f);  // nothing clamps: out-of-range values too
-    mr::ThreadPool pool(2);
     for (int S : {1, 4, 9, 16, 25, 64}) {
         mr::Framebuffer fb;
         fb.width = 13;
@@ -86,7 +84,8 @@ TEST(Resolve, BoxResolveIsTheMeanOfEachPixelsSamplesForRandomData) {
         fb.samples = S;
         fb.color.resize(static_cast<std::size_t>(fb.width) * fb.height * S * 4);
         for (float& v : fb.color) v = u(rng);
-        const mr::Image img = mr::resolve_color(fb, mr::ResolveFilter::box, pool);
+        mr::Image img(fb.width, fb.height, 4);
+        mr::resolve_tile(mr::color_window(fb), 0, 0, fb.width, fb.height, mr::ResolveFilter::box, img);
         ASSERT_EQ(img.width, fb.width);
         ASSERT_EQ(img.height, fb.height);
         ASSERT_EQ(img.channels, 4);
@@ -100,13 +99,23 @@ TEST(Resolve, BoxResolveIsTheMeanOfEachPixelsSamplesForRandomData) {
                     mean /= S;
                     EXPECT_NEAR(img.at(x, y, c), mean, mean_tolerance(xs)) << "S=" << S << " pixel (" << x << ", " << y << ")";
                 }
-        // The rvalue overload gives the same image (for S = 1 it moves the samples out).
-        mr::Framebuffer copy = fb;
-        const mr::Image moved = mr::resolve_color(std::move(copy), mr::ResolveFilter::box, pool);
-        EXPECT_EQ(moved.pixels, img.pixels) << "S=" << S;
-        EXPECT_EQ(moved.width, fb.width);
-        EXPECT_EQ(moved.height, fb.height);
-        EXPECT_EQ(moved.channels, 4);
+        // A tile-local window (origin (5, 2), its own pitch) over a copy of a sub-rectangle gives
+        // the same pixels there, and writes nothing outside it.
+        const int x0 = 5, y0 = 2, x1 = 11, y1 = 6, pitch = 8;
+        std::vector<float> local(static_cast<std::size_t>(pitch) * (y1 - y0) * S * 4, -7.0f);
+        const mr::SampleWindow window{local.data(), 4, x0, y0, pitch, S};
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x)
+                for (int s = 0; s < S; ++s)
+                    for (int c = 0; c < 4; ++c) window.at(x, y, s)[c] = fb.color[4 * fb.sample_index(x, y, s) + c];
+        mr::Image tile(fb.width, fb.height, 4);
+        mr::resolve_tile(window, x0, y0, x1, y1, mr::ResolveFilter::box, tile);
+        for (int y = 0; y < fb.height; ++y)
+            for (int x = 0; x < fb.width; ++x)
+                for (int c = 0; c < 4; ++c) {
+                    const bool inside = x >= x0 && x < x1 && y >= y0 && y < y1;
+                    EXPECT_EQ(tile.at(x, y, c), inside ? img.at(x, y, c) : 0.0f) << "S=" << S << " (" << x << ", " << y << ")";
+                }
     }
 }
 

@@ -50,6 +50,21 @@ Framebuffer make_framebuffer(int width, int height, int samples, glm::vec4 clear
     return fb;
 }
 
+void SampleWindow::fill(int x0, int y0, int x1, int y1, const glm::vec4& value) const {
+    for (int y = y0; y < y1; ++y) {
+        float* p = at(x0, y, 0);
+        float* end = at(x1 - 1, y, samples - 1) + channels;
+        for (; p != end; p += channels)
+            for (int c = 0; c < channels; ++c) p[c] = value[c];
+    }
+}
+
+SampleWindow color_window(Framebuffer& fb) { return {fb.color.data(), 4, 0, 0, fb.width, fb.samples}; }
+
+SampleWindow depth_window(Framebuffer& fb) {
+    return {fb.has_depth() ? fb.depth.data() : nullptr, 1, 0, 0, fb.width, fb.samples};
+}
+
 std::string Framebuffer::to_string() const {
     return "Framebuffer(" + std::to_string(width) + "x" + std::to_string(height) + ", samples=" +
            std::to_string(samples) + (has_depth() ? ", depth" : ", no depth") + ")";

@@ -33,7 +33,8 @@ inline glm::vec4 shade(const DrawInputs& draw, const VertexValues& colors, const
 template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode>
 void raster_tile(const TileTarget& target, const DrawInputs& draw, const TriangleBatch& batch,
                  TileCounters& counters) {
-    Framebuffer& fb = *target.framebuffer;
+    const SampleWindow& color_out = target.color;
+    const SampleWindow& depth_out = target.depth;
     const SamplePattern& pattern = *target.pattern;
     const int S = kMode == SampleMode::single ? 1 : pattern.count();
     constexpr std::int64_t kStep = kSubpixelOne;  // one pixel in fixed point
@@ -89,7 +90,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 if (!covered) continue;
                 const int px = x0 + j;
                 const std::int64_t p0 = row0 + j * step0, p1 = row1 + j * step1, p2 = row2 + j * step2;
-                const std::size_t base = fb.sample_index(px, py, 0);
+                float* const color_px = color_out.at(px, py, 0);
+                float* const depth_px = kDepth != DepthFunc::none ? depth_out.at(px, py, 0) : nullptr;
 
                 if constexpr (kMode == SampleMode::msaa) {
                     // Depth per sample, colour once per pixel: at the pixel centre when it is inside the
@@ -100,8 +102,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         ++counters.samples_covered;
                         if constexpr (kDepth != DepthFunc::none) {
                             const float z = sample_depth(t, screen_weights(t, p0 + off0[s], p1 + off1[s], p2 + off2[s]));
-                            if (!depth_passes<kDepth>(z, fb.depth[base + s])) continue;
-                            if (draw.depth_write) fb.depth[base + s] = z;
+                            if (!depth_passes<kDepth>(z, depth_px[s])) continue;
+                            if (draw.depth_write) depth_px[s] = z;
                         }
                         passed |= std::uint64_t{1} << s;
                     }
@@ -125,7 +127,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         color = shade<kShading>(draw, colors, t, screen_weights(t, c0, c1, c2), batch.clip_weights);
                     }
                     for (std::uint64_t m = passed; m; m &= m - 1)
-                        blend_into<kBlend>(&fb.color[4 * (base + __builtin_ctzll(m))], color);
+                        blend_into<kBlend>(color_px + 4 * __builtin_ctzll(m), color);
                 } else {
                     // Shade every covered sample that passes the depth test.
                     for (; covered; covered &= covered - 1) {
@@ -138,12 +140,12 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             l = screen_weights(t, e0, e1, e2);
                         if constexpr (kDepth != DepthFunc::none) {
                             const float z = sample_depth(t, l);
-                            if (!depth_passes<kDepth>(z, fb.depth[base + s])) continue;
-                            if (draw.depth_write) fb.depth[base + s] = z;
+                            if (!depth_passes<kDepth>(z, depth_px[s])) continue;
+                            if (draw.depth_write) depth_px[s] = z;
                         }
                         ++counters.samples_passed;
                         ++counters.shader_invocations;
-                        blend_into<kBlend>(&fb.color[4 * (base + s)], shade<kShading>(draw, colors, t, l, batch.clip_weights));
+                        blend_into<kBlend>(color_px + 4 * s, shade<kShading>(draw, colors, t, l, batch.clip_weights));
                     }
                 }
             }

@@ -200,11 +200,18 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     }
     stats.setup_ms = ms_since(t0);
 
-    // Stage 3: rasterize, shade, test and blend, one tile per task, triangles in submission order.
+    // Stage 3: per tile, one task each: clear, rasterize (shade, depth test, blend) the tile's
+    // triangles in submission order, and resolve. The samples live in a tile-local buffer that
+    // stays in cache; a whole-frame sample buffer exists only when the caller keeps the samples,
+    // and at one sample per pixel the colour goes straight into the image (no resolve at all).
     t0 = Clock::now();
+    const int S = settings.samples;
     const float clear_depth = camera.depth_convention == DepthConvention::opengl ? 1.0f : 0.0f;
-    Framebuffer fb = make_framebuffer(settings.width, settings.height, settings.samples, settings.clear_color,
-                                      needs_depth, clear_depth);
+    const glm::vec4 clear_depth4(clear_depth);
+    Framebuffer kept;
+    if (settings.keep_samples)
+        kept = make_framebuffer(settings.width, settings.height, S, settings.clear_color, needs_depth, clear_depth);
+    result.color = Image(settings.width, settings.height, 4);
     std::vector<TileKernel> kernels(draws.size());
     std::vector<DrawInputs> inputs(draws.size());
     for (std::size_t d = 0; d < draws.size(); ++d) {
@@ -216,9 +223,27 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     std::vector<TileCounters> tile_counters(static_cast<std::size_t>(grid.count()));
     pool.parallel_for(static_cast<std::size_t>(grid.count()), [&](std::size_t tile) {
         const int tx = static_cast<int>(tile) % grid.tiles_x, ty = static_cast<int>(tile) / grid.tiles_x;
-        const TileTarget target{&fb, &result.pattern, tx * kTileSize, ty * kTileSize,
-                                std::min((tx + 1) * kTileSize, settings.width),
-                                std::min((ty + 1) * kTileSize, settings.height)};
+        TileTarget target{{}, {}, &result.pattern, tx * kTileSize, ty * kTileSize,
+                          std::min((tx + 1) * kTileSize, settings.width), std::min((ty + 1) * kTileSize, settings.height)};
+        // Tile-local storage, reused by each worker thread from tile to tile.
+        thread_local std::vector<float> tile_color, tile_depth;
+        if (settings.keep_samples) {
+            target.color = color_window(kept);
+            target.depth = depth_window(kept);
+        } else {
+            if (S == 1) {
+                target.color = {result.color.pixels.data(), 4, 0, 0, settings.width, 1};
+            } else {
+                tile_color.resize(std::size_t{4} * kTileSize * kTileSize * static_cast<std::size_t>(S));
+                target.color = {tile_color.data(), 4, target.x0, target.y0, kTileSize, S};
+            }
+            target.color.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
+            if (needs_depth) {
+                tile_depth.resize(std::size_t{kTileSize} * kTileSize * static_cast<std::size_t>(S));
+                target.depth = {tile_depth.data(), 1, target.x0, target.y0, kTileSize, S};
+                target.depth.fill(target.x0, target.y0, target.x1, target.y1, clear_depth4);
+            }
+        }
         for (const BinnedChunk& chunk : chunks) {
             const std::uint32_t* begin = chunk.tile_triangles.data() + chunk.tile_start[tile];
             const std::uint32_t* end = chunk.tile_triangles.data() + chunk.tile_start[tile + 1];
@@ -229,23 +254,16 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                                       chunk.clip_weights.data()};
             kernels[draw](target, inputs[draw], batch, tile_counters[tile]);
         }
+        if (settings.keep_samples || S > 1)
+            resolve_tile(target.color, target.x0, target.y0, target.x1, target.y1, settings.resolve_filter, result.color);
     });
     for (const TileCounters& c : tile_counters) {
         stats.samples_covered += c.samples_covered;
         stats.samples_passed += c.samples_passed;
         stats.shader_invocations += c.shader_invocations;
     }
+    if (settings.keep_samples) result.framebuffer = std::move(kept);
     stats.raster_ms = ms_since(t0);
-
-    // Stage 4: resolve (no pass at all for one sample per pixel unless the samples are kept).
-    t0 = Clock::now();
-    if (settings.keep_samples) {
-        result.color = resolve_color(static_cast<const Framebuffer&>(fb), settings.resolve_filter, pool);
-        result.framebuffer = std::move(fb);
-    } else {
-        result.color = resolve_color(std::move(fb), settings.resolve_filter, pool);
-    }
-    stats.resolve_ms = ms_since(t0);
     stats.total_ms = ms_since(start);
     return result;
 }
@@ -269,8 +287,8 @@ std::string RenderStats::to_string() const {
            ", rasterized=" + std::to_string(triangles_rasterized) + ", samples_covered=" + std::to_string(samples_covered) +
            ", samples_passed=" + std::to_string(samples_passed) + ", shader_invocations=" +
            std::to_string(shader_invocations) + ", threads=" + std::to_string(threads) + ", transform_ms=" +
-           ms(transform_ms) + ", setup_ms=" + ms(setup_ms) + ", raster_ms=" + ms(raster_ms) + ", resolve_ms=" +
-           ms(resolve_ms) + ", total_ms=" + ms(total_ms) + ")";
+           ms(transform_ms) + ", setup_ms=" + ms(setup_ms) + ", raster_ms=" + ms(raster_ms) +
+           ", total_ms=" + ms(total_ms) + ")";
 }
 
 }  // namespace mipraster

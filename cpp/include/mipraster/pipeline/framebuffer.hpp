@@ -26,6 +26,30 @@ struct Framebuffer {
     std::string to_string() const;
 };
 
+/// A window onto sample storage (the whole framebuffer, a tile-local buffer, or an image at one
+/// sample per pixel): sample s of pixel (x, y) is element ((y − origin_y)·pitch + x − origin_x)·S + s,
+/// with `channels` floats per element.
+struct SampleWindow {
+    float* data = nullptr;
+    int channels = 4;
+    int origin_x = 0, origin_y = 0;
+    int pitch = 0;  ///< pixels per row
+    int samples = 1;
+
+    std::size_t index(int x, int y, int s) const {
+        return (static_cast<std::size_t>(y - origin_y) * static_cast<std::size_t>(pitch) +
+                static_cast<std::size_t>(x - origin_x)) * static_cast<std::size_t>(samples) + static_cast<std::size_t>(s);
+    }
+    float* at(int x, int y, int s) const { return data + index(x, y, s) * static_cast<std::size_t>(channels); }
+
+    /// Sets every sample of the pixels [x0, x1) × [y0, y1) to `value` (its first `channels` components).
+    void fill(int x0, int y0, int x1, int y1, const glm::vec4& value) const;
+};
+
+/// Windows onto a whole framebuffer's colour and depth (depth.data is null when it has none).
+SampleWindow color_window(Framebuffer& framebuffer);
+SampleWindow depth_window(Framebuffer& framebuffer);
+
 /// Bytes a framebuffer of this size needs (colour, plus depth when asked for).
 std::uint64_t framebuffer_bytes(int width, int height, int samples, bool with_depth);
 

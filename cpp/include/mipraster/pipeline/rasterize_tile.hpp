@@ -28,9 +28,10 @@ struct PipelineKey {
     SampleMode samples = SampleMode::single;
 };
 
-/// The pixel rectangle [x0, x1) × [y0, y1) of one tile and the framebuffer it writes.
+/// The pixel rectangle [x0, x1) × [y0, y1) of one tile and the sample storage it writes: RGBA
+/// colour and (when some draw tests depth) depth, each a window that covers the rectangle.
 struct TileTarget {
-    Framebuffer* framebuffer;
+    SampleWindow color, depth;
     const SamplePattern* pattern;
     int x0, y0, x1, y1;
 };

@@ -49,7 +49,9 @@ struct RenderStats {
     std::uint64_t triangles_rasterized = 0;///< set-up (sub-)triangles sent to the rasterizer
     std::uint64_t samples_covered = 0, samples_passed = 0, shader_invocations = 0;
     int threads = 1;
-    double transform_ms = 0, setup_ms = 0, raster_ms = 0, resolve_ms = 0, total_ms = 0;
+    double transform_ms = 0, setup_ms = 0;
+    double raster_ms = 0;  ///< clear, rasterize, shade, test, blend and resolve, tile by tile
+    double total_ms = 0;
 
     std::string to_string() const;
 };
