@@ -227,6 +227,93 @@ TEST(Depth, StoredDepthOfATiltedQuadMatchesTheRayCastWindowDepth) {
     expect_depth_matches_ray_cast(gl, quad_model(3.0, 0.7, 0.3), 3e-7, 1.0f);
 }
 
+/// The per-pixel depth output: each pixel's view-space depth (−z_view) is that of its nearest
+/// covered sample by the ray cast, +inf where no sample is covered; in the tile-buffer and kept-
+/// sample paths alike. The tolerance is the snapping band times the view-depth gradient plus
+/// `rel_tol` for the float window depth it is decoded from.
+void expect_view_depth_matches_ray_cast(const mr::Camera& cam, const glm::dmat4& model, double rel_tol) {
+    const int W = 48, H = 48;
+    const mr::Mesh quad = unit_quad();
+    const bool reverse = cam.depth_convention == mr::DepthConvention::reverse_z;
+    const oracle::RayCaster rc(cam.view, cam.projection, reverse, W, H);
+    std::array<glm::dvec3, 4> world;
+    for (int i = 0; i < 4; ++i) world[i] = glm::dvec3(model * glm::dvec4(glm::dvec3(quad.positions[i]), 1.0));
+    auto depth_at = [&](double sx, double sy) {
+        const oracle::Ray ray = rc.ray(sx, sy);
+        oracle::Hit h = rc.intersect(ray, world[0], world[1], world[2]);
+        if (!h.hit) h = rc.intersect(ray, world[0], world[2], world[3]);
+        return h;
+    };
+    for (int S : {1, 4}) {
+        for (bool keep : {false, true}) {
+            SCOPED_TRACE("samples " + std::to_string(S) + (keep ? ", kept samples" : ", tile buffers"));
+            auto st = settings(W, H, S);
+            st.keep_samples = keep;
+            st.depth_output = true;
+            const mr::RenderResult r = mr::render({make_draw(quad, model, mr::DrawState{})}, cam, st);
+            ASSERT_EQ(r.depth.width, W);
+            ASSERT_EQ(r.depth.channels, 1);
+            const oracle::Pattern p = to_oracle(r.pattern);
+            const std::vector<int> cov = coverage(quad, model, cam, W, H, p);
+            std::size_t checked = 0, empty = 0, bad = 0;
+            for (int y = 0; y < H; ++y)
+                for (int x = 0; x < W; ++x) {
+                    double expected = std::numeric_limits<double>::infinity(), tol = 0.0;
+                    for (int s = 0; s < S; ++s) {
+                        if (!cov[(static_cast<std::size_t>(y) * W + x) * S + s]) continue;
+                        const oracle::Fixed2 q = oracle::sample_position(x, y, p, s);
+                        const double sx = q.x / 256.0, sy = q.y / 256.0, e = 1.0 / 64;
+                        const double d = depth_at(sx, sy).view_distance;
+                        const double gx = (depth_at(sx + e, sy).view_distance - depth_at(sx - e, sy).view_distance) / (2 * e);
+                        const double gy = (depth_at(sx, sy + e).view_distance - depth_at(sx, sy - e).view_distance) / (2 * e);
+                        expected = std::min(expected, d);
+                        tol = std::max(tol, std::hypot(gx, gy) * oracle::kSnapBandPx * 1.01 + rel_tol * d);
+                    }
+                    const float got = r.depth.at(x, y, 0);
+                    if (std::isinf(expected)) {
+                        ++empty;
+                        EXPECT_TRUE(std::isinf(got) && got > 0) << "pixel (" << x << ", " << y << ") is empty but has " << got;
+                        continue;
+                    }
+                    ++checked;
+                    if (!(std::fabs(got - expected) <= tol) && ++bad < 6)
+                        ADD_FAILURE() << "pixel (" << x << ", " << y << "): view depth " << got << ", ray cast " << expected;
+                }
+            EXPECT_EQ(bad, 0u);
+            EXPECT_GT(checked, 300u);
+            EXPECT_GT(empty, 100u);
+        }
+    }
+}
+
+TEST(Depth, ViewDepthOutputIsTheNearestSamplesRayCastDepthAndInfinityWhereEmpty) {
+    expect_view_depth_matches_ray_cast(reverse_z_camera(48, 48), quad_model(3.0, 0.7, 0.3), 1e-6);
+    expect_view_depth_matches_ray_cast(reverse_z_camera(48, 48), quad_model(2000.0, 0.4, 0.9), 1e-6);
+    const double n = 0.1, t = n * std::tan(kFovy / 2);
+    const mr::Camera gl = mr::Camera::from_matrices(mr::look_at({0, 0, 0}, {0, 0, -1}, {0, 1, 0}),
+                                                    mr::frustum(-t, t, -t, t, n, 100.0, mr::DepthConvention::opengl),
+                                                    mr::DepthConvention::opengl);
+    expect_view_depth_matches_ray_cast(gl, quad_model(3.0, 0.7, 0.3), 2e-5);
+}
+
+TEST(Depth, ViewDepthOutputIsLeftOutUnlessAskedAndRefusedForProjectionsItCannotInvert) {
+    const mr::Mesh quad = unit_quad();
+    const mr::Camera cam = reverse_z_camera(16, 16);
+    auto st = settings(16, 16);
+    EXPECT_EQ(mr::render({make_draw(quad, quad_model(3.0, 0, 0), mr::DrawState{})}, cam, st).depth.pixels.size(), 0u);
+    st.depth_output = true;
+    EXPECT_EQ(mr::render({make_draw(quad, quad_model(3.0, 0, 0), mr::DrawState{})}, cam, st).depth.pixels.size(), 256u);
+    // A projection whose w row depends on x has no per-pixel inverse from window depth alone.
+    mr::Camera skew = cam;
+    skew.projection[0][3] = 0.1;
+    try {
+        mr::render({make_draw(quad, quad_model(3.0, 0, 0), mr::DrawState{})}, skew, st);
+        ADD_FAILURE() << "no error";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("depth output"), std::string::npos) << e.what();
+    }
+}
+
 TEST(Depth, IntersectingQuadsShowTheSurfaceTheRayCasterFindsNearer) {
     const int W = 64, H = 64, S = 4;
     const mr::Camera cam = reverse_z_camera(W, H);

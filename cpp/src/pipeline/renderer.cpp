@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "mipraster/core/constants.hpp"
@@ -67,6 +68,21 @@ PipelineKey pipeline_key(const Draw& draw, const Camera& camera, const RenderSet
                   : settings.anti_aliasing == AntiAliasing::msaa ? SampleMode::msaa
                                                                  : SampleMode::ssaa;
     return key;
+}
+
+// View-space depth of each pixel's nearest sample. A drawn sample always differs from the clear
+// depth (the depth test is strict), so a pixel whose samples all hold it is empty: +inf.
+void resolve_view_depth(const SampleWindow& depth, int x0, int y0, int x1, int y1, float clear_depth,
+                        const DepthDecoder& decoder, Image& out) {
+    const bool reverse = decoder.convention == DepthConvention::reverse_z;  // nearer = larger
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            const float* z = depth.at(x, y, 0);
+            float nearest = clear_depth;
+            for (int s = 0; s < depth.samples; ++s) nearest = reverse ? std::max(nearest, z[s]) : std::min(nearest, z[s]);
+            out.at(x, y, 0) = nearest == clear_depth ? std::numeric_limits<float>::infinity()
+                                                     : static_cast<float>(decoder.view_depth(nearest));
+        }
 }
 
 // Clip and set up one chunk of triangles, then bin them.
@@ -143,6 +159,8 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     RenderResult result;
     result.pattern = make_sample_pattern(settings.pattern, settings.samples, settings.pattern_seed);
     validate_draws(draws);
+    const bool depth_output = settings.depth_output && needs_depth;
+    const DepthDecoder decoder = depth_output ? camera.depth_decoder() : DepthDecoder{};
     const int threads = resolve_thread_count(settings.threads);
     ThreadPool pool(threads);
     RenderStats& stats = result.stats;
@@ -212,6 +230,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     if (settings.keep_samples)
         kept = make_framebuffer(settings.width, settings.height, S, settings.clear_color, needs_depth, clear_depth);
     result.color = Image(settings.width, settings.height, 4);
+    if (depth_output) result.depth = Image(settings.width, settings.height, 1);
     std::vector<TileKernel> kernels(draws.size());
     std::vector<DrawInputs> inputs(draws.size());
     for (std::size_t d = 0; d < draws.size(); ++d) {
@@ -256,6 +275,9 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         }
         if (settings.keep_samples || S > 1)
             resolve_tile(target.color, target.x0, target.y0, target.x1, target.y1, settings.resolve_filter, result.color);
+        if (depth_output)
+            resolve_view_depth(target.depth, target.x0, target.y0, target.x1, target.y1, clear_depth, decoder,
+                               result.depth);
     });
     for (const TileCounters& c : tile_counters) {
         stats.samples_covered += c.samples_covered;

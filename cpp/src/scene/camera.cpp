@@ -108,6 +108,18 @@ Camera Camera::from_matrices(const glm::dmat4& view, const glm::dmat4& projectio
     return Camera{view, projection, c};
 }
 
+double DepthDecoder::view_depth(float window_depth) const {
+    const double n = convention == DepthConvention::opengl ? 2.0 * window_depth - 1.0 : window_depth;
+    return -(b - d * n) / (c * n - a);
+}
+
+DepthDecoder Camera::depth_decoder() const {
+    // glm is column-major: projection[col][row].
+    require(projection[0][2] == 0.0 && projection[1][2] == 0.0 && projection[0][3] == 0.0 && projection[1][3] == 0.0,
+            "Camera: depth output needs a projection whose z and w rows depend on view-space z only");
+    return DepthDecoder{projection[2][2], projection[3][2], projection[2][3], projection[3][3], depth_convention};
+}
+
 std::string Camera::to_string() const {
     std::ostringstream s;
     s << "Camera(depth=" << mipraster::to_string(depth_convention) << ", projection=[";

@@ -32,6 +32,7 @@ struct RenderSettings {
     glm::vec4 clear_color{0.0f};                    ///< premultiplied linear RGBA
     ResolveFilter resolve_filter = ResolveFilter::box;
     bool keep_samples = false;                      ///< return the supersample framebuffer too
+    bool depth_output = false;                      ///< return RenderResult::depth (when some draw tests depth)
 
     std::string to_string() const;
 };
@@ -58,6 +59,9 @@ struct RenderStats {
 
 struct RenderResult {
     Image color;              ///< (H, W, 4) linear premultiplied RGBA after resolve
+    /// (H, W, 1) view-space depth (−z_view) of each pixel's nearest sample, +inf where no sample was
+    /// drawn; only with RenderSettings::depth_output and when some draw tests depth, else empty.
+    Image depth;
     Framebuffer framebuffer;  ///< all samples, when RenderSettings::keep_samples
     SamplePattern pattern;
     RenderStats stats;

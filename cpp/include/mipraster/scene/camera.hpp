@@ -35,6 +35,17 @@ glm::dmat4 perspective(double fovy, double aspect, double near, double far = kIn
 glm::dmat4 orthographic(double l, double r, double b, double t, double n, double f,
                         DepthConvention convention = DepthConvention::reverse_z);
 
+/// Window depth → view-space depth (−z_view, the distance along the viewing axis). Valid for
+/// projections whose z and w rows depend on view-space z only — every perspective, frustum and
+/// orthographic projection: z_clip = a·z + b, w_clip = c·z + d, so z = (b − d·n)/(c·n − a) for
+/// the NDC depth n.
+struct DepthDecoder {
+    double a = 0, b = 0, c = 0, d = 1;
+    DepthConvention convention = DepthConvention::reverse_z;
+
+    double view_depth(float window_depth) const;
+};
+
 /// A camera: world → view → clip. The library's own constructors use reverse-Z; matrices from
 /// elsewhere (OpenGL style) are accepted with DepthConvention::opengl.
 struct Camera {
@@ -49,6 +60,10 @@ struct Camera {
     /// Raw matrices, e.g. from an OpenGL program (column vectors: clip = projection · view · p).
     static Camera from_matrices(const glm::dmat4& view, const glm::dmat4& projection,
                                 DepthConvention convention = DepthConvention::opengl);
+
+    /// The decoder of this camera's window depth; throws std::invalid_argument when the
+    /// projection's z or w row depends on view-space x or y.
+    DepthDecoder depth_decoder() const;
 
     std::string to_string() const;
 };
