@@ -28,14 +28,29 @@ struct ChunkRange {
     std::uint32_t draw, first, last;
 };
 
-// A draw's vertices in clip space, with the clip volume's outcode of each (kNonFinite marks a
-// vertex with a NaN or infinite coordinate, e.g. from a degenerate matrix).
-struct ClipSpaceVertices {
+// One draw's triangles with its vertices in clip space and the clip volume's outcode of each
+// vertex (kNonFinite marks a NaN or infinite coordinate, e.g. from a degenerate matrix): the input
+// of clipping, setup and binning, whether it came from a camera (render) or not (rasterize).
+struct ClipSpaceGeometry {
     std::vector<glm::dvec4> positions;
     std::vector<std::uint8_t> outcodes;
+    const std::vector<glm::uvec3>* triangles = nullptr;
+    CullMode cull = CullMode::none;
 };
 constexpr std::uint8_t kNonFinite = 0x80;
 static_assert(kClipPlaneCount < 8, "kNonFinite must not collide with a plane bit");
+
+// Outcodes of positions [lo, hi).
+void compute_outcodes(ClipSpaceGeometry& g, std::size_t lo, std::size_t hi, const ClipVolume& volume) {
+    for (std::size_t i = lo; i < hi; ++i) {
+        const glm::dvec4& p = g.positions[i];
+        const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w);
+        g.outcodes[i] = finite ? outcode(p, volume) : kNonFinite;
+    }
+}
+
+// Vertices per task of the per-vertex stages.
+constexpr std::size_t kVertexBlock = 1 << 16;
 
 // Triangles per chunk: enough chunks for load balance, few enough that per-chunk tile tables stay
 // small. The split never changes the output (see BinnedChunk).
@@ -86,14 +101,14 @@ void resolve_view_depth(const SampleWindow& depth, int x0, int y0, int x1, int y
 }
 
 // Clip and set up one chunk of triangles, then bin them.
-void setup_chunk(const ChunkRange& range, const Draw& draw, const ClipSpaceVertices& vertices,
+void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices,
                  const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid, BinnedChunk& chunk,
                  SetupCounters& counters, std::uint64_t& clipped) {
     chunk.triangles.reserve(range.last - range.first);
     SetupTriangle st;
     ClipPolygon polygon;
     for (std::uint32_t t = range.first; t < range.last; ++t) {
-        const glm::uvec3 tri = draw.mesh->triangles[t];
+        const glm::uvec3 tri = (*vertices.triangles)[t];
         const std::array<std::uint8_t, 3> codes = {vertices.outcodes[tri[0]], vertices.outcodes[tri[1]],
                                                    vertices.outcodes[tri[2]]};
         if ((codes[0] | codes[1] | codes[2]) & kNonFinite) {
@@ -108,7 +123,7 @@ void setup_chunk(const ChunkRange& range, const Draw& draw, const ClipSpaceVerti
             case ClipOutcome::outside: ++counters.culled_outside; break;
             case ClipOutcome::inside:
                 st.clip_index = -1;
-                if (setup_triangle(p, viewport, draw.state.cull, st, counters)) chunk.triangles.push_back(st);
+                if (setup_triangle(p, viewport, vertices.cull, st, counters)) chunk.triangles.push_back(st);
                 break;
             case ClipOutcome::clipped: {
                 ++clipped;
@@ -118,7 +133,7 @@ void setup_chunk(const ChunkRange& range, const Draw& draw, const ClipSpaceVerti
                 for (int i = 1; i + 1 < polygon.count; ++i) {
                     const ClipVertex* v[3] = {&polygon.vertices[0], &polygon.vertices[i], &polygon.vertices[i + 1]};
                     st.clip_index = static_cast<std::int32_t>(chunk.clip_weights.size());
-                    if (setup_triangle({v[0]->position, v[1]->position, v[2]->position}, viewport, draw.state.cull, st,
+                    if (setup_triangle({v[0]->position, v[1]->position, v[2]->position}, viewport, vertices.cull, st,
                                        pieces)) {
                         any = true;
                         chunk.triangles.push_back(st);
@@ -139,6 +154,60 @@ void setup_chunk(const ChunkRange& range, const Draw& draw, const ClipSpaceVerti
         }
     }
     bin_triangles(chunk, grid);
+}
+
+// Stage 2: clip, set up and bin every draw's triangles, in parallel over chunks of consecutive
+// triangles; adds the triangle counts to `stats`.
+std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geometry, const ClipVolume& volume,
+                                       const Viewport& viewport, const TileGrid& grid, ThreadPool& pool,
+                                       RenderStats& stats) {
+    std::vector<ChunkRange> ranges;
+    for (std::uint32_t d = 0; d < geometry.size(); ++d) {
+        const std::size_t n = geometry[d].triangles->size();
+        stats.triangles_in += n;
+        const std::size_t size = std::max(kMinChunkTriangles, n / (4 * static_cast<std::size_t>(pool.size())) + 1);
+        for (std::size_t first = 0; first < n; first += size)
+            ranges.push_back({d, static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(std::min(n, first + size))});
+    }
+    std::vector<BinnedChunk> chunks(ranges.size());
+    std::vector<SetupCounters> setup_counters(ranges.size());
+    std::vector<std::uint64_t> clipped(ranges.size(), 0);
+    pool.parallel_for(ranges.size(), [&](std::size_t i) {
+        setup_chunk(ranges[i], geometry[ranges[i].draw], volume, viewport, grid, chunks[i], setup_counters[i],
+                    clipped[i]);
+    });
+    for (std::size_t i = 0; i < ranges.size(); ++i) {
+        stats.triangles_clipped += clipped[i];
+        stats.triangles_outside += setup_counters[i].culled_outside;
+        stats.triangles_backface += setup_counters[i].culled_backface;
+        stats.triangles_degenerate += setup_counters[i].culled_degenerate;
+        stats.triangles_nonfinite += setup_counters[i].dropped_nonfinite;
+        stats.triangles_rasterized += chunks[i].triangles.size();
+    }
+    return chunks;
+}
+
+// Stage 3 for one tile: every chunk's triangles that touch it, in submission order. A chunk
+// holds one draw's triangles: one kernel call per chunk and tile.
+void rasterize_tile_chunks(std::size_t tile, const std::vector<BinnedChunk>& chunks, const std::vector<TileKernel>& kernels,
+                           const std::vector<DrawInputs>& inputs, const TileTarget& target, TileCounters& counters) {
+    for (const BinnedChunk& chunk : chunks) {
+        const std::uint32_t* begin = chunk.tile_triangles.data() + chunk.tile_start[tile];
+        const std::uint32_t* end = chunk.tile_triangles.data() + chunk.tile_start[tile + 1];
+        if (begin == end) continue;
+        const std::uint32_t draw = chunk.triangles[*begin].draw;
+        const TriangleBatch batch{chunk.triangles.data(), begin, static_cast<std::size_t>(end - begin),
+                                  chunk.clip_weights.data()};
+        kernels[draw](target, inputs[draw], batch, counters);
+    }
+}
+
+void add_counters(const std::vector<TileCounters>& tiles, RenderStats& stats) {
+    for (const TileCounters& c : tiles) {
+        stats.samples_covered += c.samples_covered;
+        stats.samples_passed += c.samples_passed;
+        stats.shader_invocations += c.shader_invocations;
+    }
 }
 
 }  // namespace
@@ -169,53 +238,28 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     // Stage 1: vertex transform, per draw, in parallel over blocks of vertices.
     auto t0 = Clock::now();
     const ClipVolume volume = make_clip_volume(camera.depth_convention, settings.width, settings.height);
-    std::vector<ClipSpaceVertices> clip_space(draws.size());
+    std::vector<ClipSpaceGeometry> geometry(draws.size());
     for (std::size_t d = 0; d < draws.size(); ++d) {
         const Mesh& mesh = *draws[d].mesh;
         const glm::dmat4 mvp = camera.projection * camera.view * draws[d].model;
-        ClipSpaceVertices& out = clip_space[d];
-        out.positions.resize(mesh.positions.size());
-        out.outcodes.resize(mesh.positions.size());
-        constexpr std::size_t kBlock = 1 << 16;
-        pool.parallel_for((mesh.positions.size() + kBlock - 1) / kBlock, [&](std::size_t b) {
-            const std::size_t lo = b * kBlock, n = std::min(kBlock, mesh.positions.size() - lo);
-            transform_vertices(&mesh.positions[lo], n, mvp, &out.positions[lo]);
-            for (std::size_t i = lo; i < lo + n; ++i) {
-                const glm::dvec4& p = out.positions[i];
-                const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w);
-                out.outcodes[i] = finite ? outcode(p, volume) : kNonFinite;
-            }
+        ClipSpaceGeometry& g = geometry[d];
+        g.triangles = &mesh.triangles;
+        g.cull = draws[d].state.cull;
+        g.positions.resize(mesh.positions.size());
+        g.outcodes.resize(mesh.positions.size());
+        pool.parallel_for((mesh.positions.size() + kVertexBlock - 1) / kVertexBlock, [&](std::size_t b) {
+            const std::size_t lo = b * kVertexBlock, hi = std::min(lo + kVertexBlock, mesh.positions.size());
+            transform_vertices(&mesh.positions[lo], hi - lo, mvp, &g.positions[lo]);
+            compute_outcodes(g, lo, hi, volume);
         });
-        stats.triangles_in += mesh.triangles.size();
     }
     stats.transform_ms = ms_since(t0);
 
-    // Stage 2: clip, set up and bin, in parallel over chunks of consecutive triangles.
+    // Stage 2: clip, set up and bin.
     t0 = Clock::now();
     const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
     const Viewport viewport{settings.width, settings.height, camera.depth_convention};
-    std::vector<ChunkRange> ranges;
-    for (std::uint32_t d = 0; d < draws.size(); ++d) {
-        const std::size_t n = draws[d].mesh->triangles.size();
-        const std::size_t size = std::max(kMinChunkTriangles, n / (4 * static_cast<std::size_t>(threads)) + 1);
-        for (std::size_t first = 0; first < n; first += size)
-            ranges.push_back({d, static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(std::min(n, first + size))});
-    }
-    std::vector<BinnedChunk> chunks(ranges.size());
-    std::vector<SetupCounters> setup_counters(ranges.size());
-    std::vector<std::uint64_t> clipped(ranges.size(), 0);
-    pool.parallel_for(ranges.size(), [&](std::size_t i) {
-        setup_chunk(ranges[i], draws[ranges[i].draw], clip_space[ranges[i].draw], volume, viewport, grid, chunks[i],
-                    setup_counters[i], clipped[i]);
-    });
-    for (std::size_t i = 0; i < ranges.size(); ++i) {
-        stats.triangles_clipped += clipped[i];
-        stats.triangles_outside += setup_counters[i].culled_outside;
-        stats.triangles_backface += setup_counters[i].culled_backface;
-        stats.triangles_degenerate += setup_counters[i].culled_degenerate;
-        stats.triangles_nonfinite += setup_counters[i].dropped_nonfinite;
-        stats.triangles_rasterized += chunks[i].triangles.size();
-    }
+    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, pool, stats);
     stats.setup_ms = ms_since(t0);
 
     // Stage 3: per tile, one task each: clear, rasterize (shade, depth test, blend) the tile's
@@ -263,27 +307,14 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 target.depth.fill(target.x0, target.y0, target.x1, target.y1, clear_depth4);
             }
         }
-        for (const BinnedChunk& chunk : chunks) {
-            const std::uint32_t* begin = chunk.tile_triangles.data() + chunk.tile_start[tile];
-            const std::uint32_t* end = chunk.tile_triangles.data() + chunk.tile_start[tile + 1];
-            // A chunk holds one draw's triangles: one kernel call per chunk and tile.
-            if (begin == end) continue;
-            const std::uint32_t draw = chunk.triangles[*begin].draw;
-            const TriangleBatch batch{chunk.triangles.data(), begin, static_cast<std::size_t>(end - begin),
-                                      chunk.clip_weights.data()};
-            kernels[draw](target, inputs[draw], batch, tile_counters[tile]);
-        }
+        rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
         if (settings.keep_samples || S > 1)
             resolve_tile(target.color, target.x0, target.y0, target.x1, target.y1, settings.resolve_filter, result.color);
         if (depth_output)
             resolve_view_depth(target.depth, target.x0, target.y0, target.x1, target.y1, clear_depth, decoder,
                                result.depth);
     });
-    for (const TileCounters& c : tile_counters) {
-        stats.samples_covered += c.samples_covered;
-        stats.samples_passed += c.samples_passed;
-        stats.shader_invocations += c.shader_invocations;
-    }
+    add_counters(tile_counters, stats);
     if (settings.keep_samples) result.framebuffer = std::move(kept);
     stats.raster_ms = ms_since(t0);
     stats.total_ms = ms_since(start);
