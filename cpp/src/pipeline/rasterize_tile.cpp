@@ -47,7 +47,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
 
         // The vertex colours of the original triangle, once per triangle and tile.
         VertexValues colors;
-        if constexpr (kShading != Shading::constant) {
+        if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective) {
             const glm::uvec3 tri = draw.triangles[t.triangle];
             colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
         }
@@ -90,7 +90,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 if (!covered) continue;
                 const int px = x0 + j;
                 const std::int64_t p0 = row0 + j * step0, p1 = row1 + j * step1, p2 = row2 + j * step2;
-                float* const color_px = color_out.at(px, py, 0);
+                float* const color_px = kShading == Shading::visibility ? nullptr : color_out.at(px, py, 0);
                 float* const depth_px = kDepth != DepthFunc::none ? depth_out.at(px, py, 0) : nullptr;
 
                 if constexpr (kMode == SampleMode::msaa) {
@@ -136,7 +136,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         const std::int64_t e0 = p0 + off0[s], e1 = p1 + off1[s], e2 = p2 + off2[s];
                         glm::dvec3 l(0.0);
                         if constexpr (kDepth != DepthFunc::none || kShading == Shading::screen ||
-                                      kShading == Shading::perspective)
+                                      kShading == Shading::perspective || kShading == Shading::visibility)
                             l = screen_weights(t, e0, e1, e2);
                         if constexpr (kDepth != DepthFunc::none) {
                             const float z = sample_depth(t, l);
@@ -144,8 +144,16 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             if (draw.depth_write) depth_px[s] = z;
                         }
                         ++counters.samples_passed;
-                        ++counters.shader_invocations;
-                        blend_into<kBlend>(color_px + 4 * s, shade<kShading>(draw, colors, t, l, batch.clip_weights));
+                        if constexpr (kShading == Shading::visibility) {
+                            const glm::dvec3 w = original_weights(t, perspective_weights(t, l), batch.clip_weights);
+                            const std::size_t i = target.barycentrics.index(px, py, s);
+                            target.triangle_ids[i] = static_cast<std::int32_t>(t.triangle);
+                            target.barycentrics.data[2 * i] = static_cast<float>(w.y);
+                            target.barycentrics.data[2 * i + 1] = static_cast<float>(w.z);
+                        } else {
+                            ++counters.shader_invocations;
+                            blend_into<kBlend>(color_px + 4 * s, shade<kShading>(draw, colors, t, l, batch.clip_weights));
+                        }
                     }
                 }
             }
@@ -171,8 +179,16 @@ TileKernel pick_shading(const PipelineKey& k) {
         case Shading::flat: return pick_mode<D, B, Shading::flat>(k.samples);
         case Shading::screen: return pick_mode<D, B, Shading::screen>(k.samples);
         case Shading::perspective: return pick_mode<D, B, Shading::perspective>(k.samples);
+        case Shading::visibility: break;  // see select_tile_kernel
     }
     return nullptr;
+}
+
+// Visibility records every covered sample that passes the depth test: no blending, no MSAA.
+template <DepthFunc D>
+TileKernel pick_visibility(SampleMode m) {
+    return m == SampleMode::single ? &raster_tile<D, BlendMode::replace, Shading::visibility, SampleMode::single>
+                                   : &raster_tile<D, BlendMode::replace, Shading::visibility, SampleMode::ssaa>;
 }
 
 template <DepthFunc D>
@@ -188,6 +204,13 @@ TileKernel pick_blend(const PipelineKey& k) {
 }  // namespace
 
 TileKernel select_tile_kernel(const PipelineKey& k) {
+    if (k.shading == Shading::visibility) {
+        switch (k.depth) {
+            case DepthFunc::none: return pick_visibility<DepthFunc::none>(k.samples);
+            case DepthFunc::greater: return pick_visibility<DepthFunc::greater>(k.samples);
+            case DepthFunc::less: return pick_visibility<DepthFunc::less>(k.samples);
+        }
+    }
     switch (k.depth) {
         case DepthFunc::none: return pick_blend<DepthFunc::none>(k);
         case DepthFunc::greater: return pick_blend<DepthFunc::greater>(k);

@@ -202,6 +202,18 @@ void rasterize_tile_chunks(std::size_t tile, const std::vector<BinnedChunk>& chu
     }
 }
 
+// The pixel rectangle of a tile; its storage windows are the caller's to set.
+TileTarget tile_target(const TileGrid& grid, std::size_t tile, const SamplePattern& pattern) {
+    const int tx = static_cast<int>(tile) % grid.tiles_x, ty = static_cast<int>(tile) / grid.tiles_x;
+    TileTarget target;
+    target.pattern = &pattern;
+    target.x0 = tx * kTileSize;
+    target.y0 = ty * kTileSize;
+    target.x1 = std::min((tx + 1) * kTileSize, grid.width);
+    target.y1 = std::min((ty + 1) * kTileSize, grid.height);
+    return target;
+}
+
 void add_counters(const std::vector<TileCounters>& tiles, RenderStats& stats) {
     for (const TileCounters& c : tiles) {
         stats.samples_covered += c.samples_covered;
@@ -285,9 +297,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     }
     std::vector<TileCounters> tile_counters(static_cast<std::size_t>(grid.count()));
     pool.parallel_for(static_cast<std::size_t>(grid.count()), [&](std::size_t tile) {
-        const int tx = static_cast<int>(tile) % grid.tiles_x, ty = static_cast<int>(tile) / grid.tiles_x;
-        TileTarget target{{}, {}, &result.pattern, tx * kTileSize, ty * kTileSize,
-                          std::min((tx + 1) * kTileSize, settings.width), std::min((ty + 1) * kTileSize, settings.height)};
+        TileTarget target = tile_target(grid, tile, result.pattern);
         // Tile-local storage, reused by each worker thread from tile to tile.
         thread_local std::vector<float> tile_color, tile_depth;
         if (settings.keep_samples) {
@@ -319,6 +329,90 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     stats.raster_ms = ms_since(t0);
     stats.total_ms = ms_since(start);
     return result;
+}
+
+Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::vector<glm::uvec3>& triangles,
+                     const RasterizeSettings& settings) {
+    const auto start = Clock::now();
+    // Validate everything before allocating anything large.
+    validate_framebuffer_size(settings.width, settings.height, settings.samples, true);
+    Visibility out;
+    out.pattern = make_sample_pattern(settings.pattern, settings.samples, settings.pattern_seed);
+    for (std::size_t i = 0; i < clip_positions.size(); ++i)
+        for (int c = 0; c < 4; ++c)
+            if (!std::isfinite(clip_positions[i][c]))
+                throw std::invalid_argument("clip_positions[" + std::to_string(i) + "][" + std::to_string(c) + "] is " +
+                                            std::to_string(clip_positions[i][c]) + "; expected a finite number");
+    if (triangles.size() >= (std::size_t{1} << 31))
+        throw std::invalid_argument("triangles: at most 2^31 - 1 triangles (ids are int32)");
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k)
+            if (triangles[t][k] >= clip_positions.size())
+                throw std::invalid_argument("triangles[" + std::to_string(t) + "][" + std::to_string(k) + "] = " +
+                                            std::to_string(triangles[t][k]) + " is out of range; expected < " +
+                                            std::to_string(clip_positions.size()) + " (the vertex count)");
+    const int threads = resolve_thread_count(settings.threads);
+    ThreadPool pool(threads);
+    RenderStats& stats = out.stats;
+    stats.threads = threads;
+
+    // Stage 1: outcodes of the given clip-space vertices.
+    auto t0 = Clock::now();
+    const ClipVolume volume = make_clip_volume(settings.depth_convention, settings.width, settings.height);
+    std::vector<ClipSpaceGeometry> geometry(1);
+    ClipSpaceGeometry& g = geometry[0];
+    g.positions = clip_positions;
+    g.outcodes.resize(clip_positions.size());
+    g.triangles = &triangles;
+    g.cull = settings.cull;
+    pool.parallel_for((clip_positions.size() + kVertexBlock - 1) / kVertexBlock, [&](std::size_t b) {
+        compute_outcodes(g, b * kVertexBlock, std::min((b + 1) * kVertexBlock, clip_positions.size()), volume);
+    });
+    stats.transform_ms = ms_since(t0);
+
+    // Stage 2: clip, set up and bin.
+    t0 = Clock::now();
+    const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
+    const Viewport viewport{settings.width, settings.height, settings.depth_convention};
+    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, pool, stats);
+    stats.setup_ms = ms_since(t0);
+
+    // Stage 3: every tile records the nearest triangle of each sample.
+    t0 = Clock::now();
+    const int S = settings.samples;
+    const std::size_t n = static_cast<std::size_t>(settings.width) * settings.height * S;
+    const bool opengl = settings.depth_convention == DepthConvention::opengl;
+    out.width = settings.width;
+    out.height = settings.height;
+    out.samples = S;
+    out.triangle_id.assign(n, -1);
+    out.barycentrics.assign(2 * n, 0.0f);
+    out.depth.assign(n, opengl ? 1.0f : 0.0f);
+    PipelineKey key;
+    key.depth = opengl ? DepthFunc::less : DepthFunc::greater;
+    key.shading = Shading::visibility;
+    key.samples = S == 1 ? SampleMode::single : SampleMode::ssaa;
+    const std::vector<TileKernel> kernels = {select_tile_kernel(key)};
+    const std::vector<DrawInputs> inputs = {{triangles.data(), nullptr, glm::vec4(1.0f), true}};
+    std::vector<TileCounters> tile_counters(static_cast<std::size_t>(grid.count()));
+    pool.parallel_for(static_cast<std::size_t>(grid.count()), [&](std::size_t tile) {
+        TileTarget target = tile_target(grid, tile, out.pattern);
+        target.depth = {out.depth.data(), 1, 0, 0, settings.width, S};
+        target.triangle_ids = out.triangle_id.data();
+        target.barycentrics = {out.barycentrics.data(), 2, 0, 0, settings.width, S};
+        rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
+    });
+    add_counters(tile_counters, stats);
+    stats.raster_ms = ms_since(t0);
+    stats.total_ms = ms_since(start);
+    return out;
+}
+
+std::string RasterizeSettings::to_string() const {
+    return "RasterizeSettings(" + std::to_string(width) + "x" + std::to_string(height) + ", samples=" +
+           std::to_string(samples) + ", pattern=" + mipraster::to_string(pattern) + ", depth=" +
+           mipraster::to_string(depth_convention) + ", cull=" + mipraster::to_string(cull) + ", threads=" +
+           std::to_string(threads) + ")";
 }
 
 std::string RenderSettings::to_string() const {

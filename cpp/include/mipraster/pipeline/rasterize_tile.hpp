@@ -16,8 +16,9 @@ namespace mipraster {
 
 enum class DepthFunc { none, greater, less };
 /// What a fragment's colour needs: nothing but the draw colour, the provoking vertex's colour,
-/// or interpolated vertex colours (screen space or perspective-correct).
-enum class Shading { constant, flat, screen, perspective };
+/// or interpolated vertex colours (screen space or perspective-correct). `visibility` shades
+/// nothing: it records which triangle covers each sample and its perspective-correct barycentrics.
+enum class Shading { constant, flat, screen, perspective, visibility };
 /// single: one sample per pixel; ssaa: shade every sample; msaa: shade once per pixel per triangle.
 enum class SampleMode { single, ssaa, msaa };
 
@@ -34,6 +35,10 @@ struct TileTarget {
     SampleWindow color, depth;
     const SamplePattern* pattern;
     int x0, y0, x1, y1;
+    /// Shading::visibility only: per sample, the original triangle's index (indexed like `depth`)
+    /// and the weights of its 2nd and 3rd vertex (a 2-channel window).
+    std::int32_t* triangle_ids = nullptr;
+    SampleWindow barycentrics;
 };
 
 /// Per-draw inputs of the kernel.

@@ -71,4 +71,37 @@ struct RenderResult {
 /// std::invalid_argument naming it, before any large allocation.
 RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const RenderSettings& settings);
 
+/// Settings of rasterize().
+struct RasterizeSettings {
+    int width = 0, height = 0;
+    int samples = 1;                               ///< samples per pixel, 1…64
+    PatternKind pattern = PatternKind::automatic;  ///< see make_sample_pattern
+    std::uint64_t pattern_seed = 0;
+    int threads = 0;                               ///< 0 = all hardware threads
+    /// The convention of the clip-space z: opengl (−w ≤ z ≤ w, nearer = smaller) or reverse_z
+    /// (0 ≤ z ≤ w, nearer = larger).
+    DepthConvention depth_convention = DepthConvention::opengl;
+    CullMode cull = CullMode::none;
+
+    std::string to_string() const;
+};
+
+/// Per sample: the nearest triangle that covers it and where. Arrays are (H, W, S[, 2]) with
+/// sample s of pixel (x, y) at (y·W + x)·S + s.
+struct Visibility {
+    int width = 0, height = 0, samples = 1;
+    std::vector<std::int32_t> triangle_id;  ///< index into the triangles; −1 where none covers the sample
+    std::vector<float> barycentrics;        ///< perspective-correct weights of the triangle's 2nd and 3rd vertex
+    std::vector<float> depth;               ///< window depth; the clear value (opengl 1, reverse_z 0) where empty
+    SamplePattern pattern;
+    RenderStats stats;
+};
+
+/// The primitive layer: clipping, watertight rasterization and the depth test of triangles given
+/// by clip-space vertex positions (no camera, no shading). Barycentrics refer to the submitted
+/// triangle even where it was clipped. Non-finite positions and out-of-range indices throw
+/// std::invalid_argument naming the element.
+Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::vector<glm::uvec3>& triangles,
+                     const RasterizeSettings& settings);
+
 }  // namespace mipraster
