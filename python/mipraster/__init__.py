@@ -1,7 +1,48 @@
-"""mipraster: a CPU software rasterizer.
+"""mipraster: a CPU software rasterizer (C++17) driven from numpy.
 
-The renderer itself is C++ (the ``mipraster`` command installed next to this package); this
-package is its Python side.
+Build a scene from numpy arrays, pick a camera and render::
+
+    import numpy as np
+    import mipraster as mr
+
+    mesh = mr.Mesh(positions=[[-1, 0, 0], [1, 0, 0], [0, 1.5, 0]], triangles=[[0, 1, 2]],
+                   colors=[[1, 0, 0], [0, 1, 0], [0, 0, 1]])        # linear RGB(A)
+    scene = mr.Scene()
+    scene.add(mesh, cull="none")
+    camera = mr.Camera.look_at(eye=(0, 0.5, 3), target=(0, 0.5, 0), fov_y=45)
+    result = mr.render(scene, camera, 640, 360, spp=4, aa="msaa")
+    result.color          # (360, 640, 4) float32, linear premultiplied RGBA
+    result.save("triangle.png")                                    # sRGB 8-bit
+
+Conventions: right-handed world, the camera looks down −z with +y up; arrays are (H, W, C) with
+row 0 at the top; pixel (i, j) covers [i, i+1) × [j, j+1), its centre is (i + ½, j + ½); colour
+is linear premultiplied RGBA; the library's cameras use reverse-Z depth.
+
+The scene layer (:class:`Mesh`, :class:`Camera`, :class:`Scene`, :func:`render`) is pure Python
+over the C++ module ``mipraster._core``, which depends on nothing but the C++ standard library.
+Image files (:func:`read_image`, :func:`write_image`, :meth:`RenderResult.save`) use
+``mipraster._image`` (OpenImageIO), imported on first use only, so ``import mipraster`` is fast.
 """
+from ._core import linear_to_srgb, linear_to_srgb8, srgb_to_linear
+from .camera import Camera
+from .image import read_image, to_srgb8, write_image
+from .mesh import Mesh
+from .render import RenderResult, render
+from .scene import Draw, Scene
 
 __version__ = "0.1.0"
+
+__all__ = [
+    "Camera",
+    "Draw",
+    "Mesh",
+    "RenderResult",
+    "Scene",
+    "linear_to_srgb",
+    "linear_to_srgb8",
+    "read_image",
+    "render",
+    "srgb_to_linear",
+    "to_srgb8",
+    "write_image",
+]

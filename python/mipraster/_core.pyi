@@ -1,0 +1,181 @@
+"""mipraster's C++ core: meshes, cameras, draws and the renderer (no file I/O; see mipraster._image)."""
+from typing import Any, ClassVar, Dict, List, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+_ArrayLike = npt.ArrayLike
+_Float32Array = npt.NDArray[np.float32]
+_Float64Array = npt.NDArray[np.float64]
+_RGBA = Tuple[float, float, float, float]
+
+INFINITE_FAR: float
+MAX_DIMENSION: int
+MAX_SAMPLES: int
+MAX_THREADS: int
+SUBPIXEL_ONE: int
+
+class _Enum:
+    name: str
+    value: int
+    __members__: ClassVar[Dict[str, Any]]
+    def __init__(self, value: int) -> None: ...
+    def __int__(self) -> int: ...
+    def __index__(self) -> int: ...
+    def __eq__(self, other: object) -> bool: ...
+    def __hash__(self) -> int: ...
+
+class DepthConvention(_Enum):
+    reverse_z: ClassVar[DepthConvention]
+    opengl: ClassVar[DepthConvention]
+
+class BlendMode(_Enum):
+    replace: ClassVar[BlendMode]
+    add: ClassVar[BlendMode]
+    over: ClassVar[BlendMode]
+
+class Interpolation(_Enum):
+    flat: ClassVar[Interpolation]
+    screen: ClassVar[Interpolation]
+    perspective: ClassVar[Interpolation]
+
+class CullMode(_Enum):
+    none: ClassVar[CullMode]
+    back: ClassVar[CullMode]
+    front: ClassVar[CullMode]
+
+class AntiAliasing(_Enum):
+    ssaa: ClassVar[AntiAliasing]
+    msaa: ClassVar[AntiAliasing]
+
+class PatternKind(_Enum):
+    automatic: ClassVar[PatternKind]
+    center: ClassVar[PatternKind]
+    grid: ClassVar[PatternKind]
+    rotated: ClassVar[PatternKind]
+    stratified: ClassVar[PatternKind]
+
+# --- camera matrices: (4, 4) float64, clip = projection @ view @ [x, y, z, 1] -------------------
+
+def look_at(eye: _ArrayLike, target: _ArrayLike, up: _ArrayLike) -> _Float64Array: ...
+def frustum(
+    left: float, right: float, bottom: float, top: float, near: float, far: float = ...,
+    depth_convention: DepthConvention = ...,
+) -> _Float64Array: ...
+def perspective(
+    fovy: float, aspect: float, near: float, far: float = ..., depth_convention: DepthConvention = ...
+) -> _Float64Array: ...
+def orthographic(
+    left: float, right: float, bottom: float, top: float, near: float, far: float,
+    depth_convention: DepthConvention = ...,
+) -> _Float64Array: ...
+
+class Camera:
+    def __init__(
+        self, view: _ArrayLike, projection: _ArrayLike, depth_convention: DepthConvention = ...
+    ) -> None: ...
+    @staticmethod
+    def look_at_perspective(
+        eye: _ArrayLike, target: _ArrayLike, up: _ArrayLike, fovy: float, aspect: float, near: float
+    ) -> Camera: ...
+    @staticmethod
+    def from_matrices(
+        view: _ArrayLike, projection: _ArrayLike, depth_convention: DepthConvention = ...
+    ) -> Camera: ...
+    @property
+    def view(self) -> _Float64Array: ...
+    @property
+    def projection(self) -> _Float64Array: ...
+    @property
+    def depth_convention(self) -> DepthConvention: ...
+
+class Mesh:
+    def __init__(
+        self, positions: _ArrayLike, triangles: _ArrayLike, colors: Optional[_ArrayLike] = None
+    ) -> None: ...
+    @property
+    def positions(self) -> _Float32Array: ...
+    @property
+    def triangles(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def colors(self) -> Optional[_Float32Array]: ...
+    @property
+    def vertex_count(self) -> int: ...
+    @property
+    def triangle_count(self) -> int: ...
+    def has_colors(self) -> bool: ...
+    def validate(self, name: str = "mesh") -> None: ...
+
+class Draw:
+    def __init__(
+        self,
+        mesh: Mesh,
+        model: Optional[_ArrayLike] = None,
+        color: _ArrayLike = ...,
+        depth_test: bool = True,
+        depth_write: bool = True,
+        blend: BlendMode = ...,
+        interpolation: Interpolation = ...,
+        cull: CullMode = ...,
+    ) -> None: ...
+    @property
+    def mesh(self) -> Mesh: ...
+    @property
+    def model(self) -> _Float64Array: ...
+    @property
+    def color(self) -> _RGBA: ...
+    @property
+    def depth_test(self) -> bool: ...
+    @property
+    def depth_write(self) -> bool: ...
+    @property
+    def blend(self) -> BlendMode: ...
+    @property
+    def interpolation(self) -> Interpolation: ...
+    @property
+    def cull(self) -> CullMode: ...
+
+class DemoScene:
+    @property
+    def meshes(self) -> List[Mesh]: ...
+    @property
+    def draws(self) -> List[Draw]: ...
+    @property
+    def camera(self) -> Camera: ...
+    @property
+    def clear_color(self) -> _RGBA: ...
+
+def make_demo_scene(aspect: float) -> DemoScene: ...
+
+# --- rendering ---------------------------------------------------------------------------------
+
+def parse_pattern_kind(name: str) -> PatternKind: ...
+def parse_anti_aliasing(name: str) -> AntiAliasing: ...
+
+class RenderSettings:
+    width: int
+    height: int
+    samples: int
+    pattern: PatternKind
+    pattern_seed: int
+    anti_aliasing: AntiAliasing
+    threads: int
+    keep_samples: bool
+    def __init__(self) -> None: ...
+    @property
+    def clear_color(self) -> _RGBA: ...
+    @clear_color.setter
+    def clear_color(self, value: _ArrayLike) -> None: ...
+
+def sample_pattern(kind: PatternKind, samples: int, seed: int = 0) -> _Float64Array: ...
+def validate_framebuffer_size(width: int, height: int, samples: int, with_depth: bool) -> None: ...
+def render(draws: List[Draw], camera: Camera, settings: RenderSettings) -> Dict[str, Any]:
+    """Keys: color (H, W, 4) float32; samples (H, W, S, 4) float32 or None; sample_depth (H, W, S)
+    float32 or None; pattern (S, 2) float64; pattern_kind str; stats dict."""
+
+# --- colour ------------------------------------------------------------------------------------
+
+def to_srgb8(image: _ArrayLike) -> npt.NDArray[np.uint8]: ...
+def srgb_to_linear(encoded: Union[float, _ArrayLike]) -> Any: ...
+def linear_to_srgb(linear: Union[float, _ArrayLike]) -> Any: ...
+def linear_to_srgb8(linear: Union[float, _ArrayLike]) -> Any: ...

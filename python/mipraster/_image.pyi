@@ -1,0 +1,6 @@
+"""mipraster's image files (OpenImageIO): PNG (sRGB 8-bit) and EXR (linear float) output, any input."""
+import numpy as np
+import numpy.typing as npt
+
+def read_image(path: str) -> npt.NDArray[np.float32]: ...
+def write_image(path: str, image: npt.ArrayLike) -> None: ...

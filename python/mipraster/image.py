@@ -1,0 +1,89 @@
+"""Image files and sRGB encoding.
+
+Files go through ``mipraster._image`` (OpenImageIO), which is imported the first time a file is
+read or written, never by ``import mipraster``. sRGB encoding lives in ``mipraster._core``.
+"""
+from __future__ import annotations
+
+import errno
+import os
+from types import ModuleType
+from typing import Any, Union
+
+import numpy as np
+
+from . import _checks, _core
+
+__all__ = ["read_image", "write_image", "to_srgb8"]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def _image_module() -> ModuleType:
+    """The OpenImageIO-backed extension module, loaded on first use."""
+    from . import _image
+
+    return _image
+
+
+def _path(path: Any) -> str:
+    if isinstance(path, bytes):
+        return os.fsdecode(path)
+    try:
+        return os.fspath(path)
+    except TypeError:
+        raise TypeError(f"path: expected str or os.PathLike, got {type(path).__name__}") from None
+
+
+def _float_image(image: Any, name: str) -> np.ndarray:
+    a = _checks.real_array(
+        image, name, integers=False,
+        hint="; expected linear float values (premultiplied RGBA), e.g. mipraster.srgb_to_linear(rgb8 / 255)",
+    )
+    _checks.check_shape(a, name, (None, None), (None, None, 1), (None, None, 3), (None, None, 4), letters=("H", "W"))
+    return a
+
+
+def read_image(path: PathLike) -> np.ndarray:
+    """Reads an image file into ``(H, W, 4)`` float32, linear premultiplied RGBA.
+
+    8- and 16-bit files (PNG, JPEG, ...) are decoded from sRGB with straight alpha; float files
+    (EXR, HDR, float TIFF) are read as they are. Grey becomes (g, g, g, 1), RGB gets alpha 1.
+
+    Raises:
+        FileNotFoundError: there is no such file.
+        OSError: the file cannot be read (the message names the path; ``.filename`` is set).
+    """
+    p = _path(path)
+    if not os.path.exists(p):
+        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), p)
+    return _image_module().read_image(p)
+
+
+def write_image(path: PathLike, image: Any) -> None:
+    """Writes a linear float image; the format follows the extension.
+
+    Args:
+        path: ``.png`` (sRGB 8-bit; RGBA un-premultiplied to straight alpha; 1 channel written as
+            plain grey) or ``.exr`` (32-bit float, values as given).
+        image: ``(H, W, 4)`` linear premultiplied RGBA, ``(H, W, 3)`` linear RGB, or ``(H, W)`` /
+            ``(H, W, 1)`` data, any float dtype.
+
+    Raises:
+        TypeError: a non-float image.
+        ValueError: a wrong shape or an unsupported extension.
+        OSError: the file cannot be written (the message names the path; ``.filename`` is set).
+    """
+    p = _path(path)
+    a = _float_image(image, "image")
+    _image_module().write_image(p, np.ascontiguousarray(a, dtype=np.float32))
+
+
+def to_srgb8(image: Any) -> np.ndarray:
+    """Linear premultiplied ``(H, W, 4)`` float (or linear ``(H, W, 3)``, ``(H, W)``) → ``(H, W, 4)`` uint8.
+
+    Colour is un-premultiplied and sRGB-encoded (linear 0.5 → 188), alpha stored linearly: the
+    bytes a PNG written by :func:`write_image` holds.
+    """
+    a = _float_image(image, "image")
+    return _core.to_srgb8(np.ascontiguousarray(a, dtype=np.float32))

@@ -1,0 +1,125 @@
+"""Triangle meshes from numpy arrays."""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from . import _checks, _core
+
+__all__ = ["Mesh"]
+
+
+class Mesh:
+    """Indexed triangles: vertex positions, triangle indices and optional vertex colours.
+
+    Args:
+        positions: ``(N, 3)`` vertex positions, any float or integer dtype (stored as float32).
+        triangles: ``(T, 3)`` vertex indices, any integer dtype, each in ``0 <= i < N``
+            (stored as uint32).
+        colors: optional ``(N, 3)`` or ``(N, 4)`` vertex colours, linear and premultiplied RGBA
+            (alpha 1 when 3 channels are given), stored as float32. Integer arrays (e.g. a list
+            like ``[[1, 0, 0], ...]``) are accepted when every value is 0 or 1; 8-bit sRGB codes
+            are refused (convert them with ``mipraster.srgb_to_linear(rgb8 / 255)``).
+
+    Lists, non-contiguous and Fortran-order arrays are accepted; the data are checked, converted
+    and copied once into the C++ mesh. ``positions``, ``triangles`` and ``colors`` read back as
+    read-only views of that copy.
+
+    Raises:
+        TypeError: an array of bool, complex, string or object dtype, or float triangles.
+        ValueError: a wrong shape, a NaN or infinite value (naming its row and column), or an
+            index that is negative or not below the vertex count (naming the triangle and corner),
+            or an integer colour other than 0 or 1.
+    """
+
+    __slots__ = ("_mesh",)
+
+    def __init__(self, positions: Any, triangles: Any, colors: Optional[Any] = None) -> None:
+        pos = _checks.empty_rows(_checks.real_array(positions, "positions"), 3)
+        _checks.check_shape(pos, "positions", (None, 3))
+        _checks.check_finite(pos, "positions")
+        pos32 = _checks.to_float32(pos, "positions")
+        n = pos32.shape[0]
+
+        tri = _checks.integer_array(
+            triangles, "triangles", hint="; convert vertex indices with .astype(np.uint32)")
+        tri = _checks.empty_rows(tri, 3)
+        _checks.check_shape(tri, "triangles", (None, 3), letters=("T",))
+        if tri.size:
+            _check_indices(tri, n)
+        tri32 = np.ascontiguousarray(tri, dtype=np.uint32)
+
+        col32 = None
+        if colors is not None:
+            col = _checks.empty_rows(_checks.real_array(colors, "colors"), 4)
+            _checks.check_shape(col, "colors", (n, 3), (n, 4))
+            _checks.check_finite(col, "colors")
+            _check_integer_colors(col)
+            if col.shape[1] == 3:
+                col = np.concatenate([col, np.ones((n, 1), dtype=col.dtype)], axis=1)
+            col32 = _checks.to_float32(col, "colors")
+
+        self._mesh = _core.Mesh(pos32, tri32, col32)
+
+    @classmethod
+    def _from_core(cls, mesh: _core.Mesh) -> "Mesh":
+        """Wraps an existing C++ mesh (e.g. the demo's) without copying or re-checking it."""
+        self = cls.__new__(cls)
+        self._mesh = mesh
+        return self
+
+    @property
+    def positions(self) -> np.ndarray:
+        """``(N, 3)`` float32 vertex positions (read-only view)."""
+        return self._mesh.positions
+
+    @property
+    def triangles(self) -> np.ndarray:
+        """``(T, 3)`` uint32 vertex indices (read-only view)."""
+        return self._mesh.triangles
+
+    @property
+    def colors(self) -> Optional[np.ndarray]:
+        """``(N, 4)`` float32 linear premultiplied RGBA (read-only view), or None."""
+        return self._mesh.colors
+
+    @property
+    def vertex_count(self) -> int:
+        """Number of vertices N."""
+        return self._mesh.vertex_count
+
+    @property
+    def triangle_count(self) -> int:
+        """Number of triangles T."""
+        return self._mesh.triangle_count
+
+    def __repr__(self) -> str:
+        colors = ", colors=RGBA" if self._mesh.has_colors() else ""
+        return f"Mesh(vertices={self.vertex_count}, triangles={self.triangle_count}{colors})"
+
+
+def _check_indices(tri: np.ndarray, n: int) -> None:
+    """ValueError naming the first negative or out-of-range index (triangle row and corner)."""
+    bad = (tri >= n) if tri.dtype.kind == "u" else ((tri < 0) | (tri >= n))
+    if not bad.any():
+        return
+    t, k = (int(i) for i in np.argwhere(bad)[0])
+    value = int(tri[t, k])
+    where = f"triangles[{t}, {k}] (triangle {t}, corner {k}) = {value}"
+    if value < 0:
+        raise ValueError(f"{where} is negative; indices must satisfy 0 <= index < {n} (the vertex count)")
+    raise ValueError(f"{where} is out of range; indices must satisfy 0 <= index < {n} (the vertex count)")
+
+
+def _check_integer_colors(col: np.ndarray) -> None:
+    """Integer colours are linear values: only 0 and 1 make sense (255 is an 8-bit code)."""
+    if col.dtype.kind not in "iu" or col.size == 0:
+        return
+    bad = (col != 0) & (col != 1)
+    if bad.any():
+        r, c = (int(i) for i in np.argwhere(bad)[0])
+        raise ValueError(
+            f"colors[{r}, {c}] (row {r}, column {c}) = {int(col[r, c])}: integer colours are taken as linear "
+            "values and must be 0 or 1; pass floats, or for 8-bit sRGB codes mipraster.srgb_to_linear(rgb8 / 255)"
+        )

@@ -1,0 +1,153 @@
+"""Rendering a scene: :func:`render` and its :class:`RenderResult`."""
+from __future__ import annotations
+
+import os
+from typing import Any, Dict, Optional, Union
+
+import numpy as np
+
+from . import _checks, _core
+from .camera import Camera
+from .scene import Scene, _core_draws
+
+__all__ = ["render", "RenderResult"]
+
+ANTI_ALIASING = {"ssaa": _core.AntiAliasing.ssaa, "msaa": _core.AntiAliasing.msaa}
+PATTERNS = {
+    "auto": _core.PatternKind.automatic,
+    "center": _core.PatternKind.center,
+    "grid": _core.PatternKind.grid,
+    "rotated": _core.PatternKind.rotated,
+    "stratified": _core.PatternKind.stratified,
+}
+
+_INT32_MIN, _INT32_MAX = -(2**31), 2**31 - 1
+
+
+class RenderResult:
+    """The output of :func:`render`.
+
+    Attributes:
+        color: ``(H, W, 4)`` float32, linear premultiplied RGBA after the resolve. The array owns
+            the renderer's buffer (no copy was made) and is writable.
+        samples: ``(H, W, S, 4)`` float32 supersamples when the render kept them, else None.
+        sample_depth: ``(H, W, S)`` float32 window depth of every sample when the render kept the
+            samples and a draw tests depth, else None. Reverse-Z cameras: 1 at near, 0 at far/cleared;
+            OpenGL-style matrices: z_ndc / 2 + ½, 1 cleared.
+        pattern: ``(S, 2)`` float64 sample offsets from the pixel's top-left corner, in pixels
+            (multiples of 1/256).
+        pattern_kind: the pattern used (``"center"``, ``"grid"``, ``"rotated"`` or ``"stratified"``).
+        stats: dict of the renderer's counters (``triangles_in``, ``triangles_clipped``,
+            ``triangles_outside``, ``triangles_backface``, ``triangles_degenerate``,
+            ``triangles_nonfinite``, ``triangles_rasterized``, ``samples_covered``,
+            ``samples_passed``, ``shader_invocations``, ``threads``) and times in milliseconds
+            (``transform_ms``, ``setup_ms``, ``raster_ms``, ``total_ms``).
+    """
+
+    __slots__ = ("color", "samples", "sample_depth", "pattern", "pattern_kind", "stats")
+
+    def __init__(self, raw: Dict[str, Any]) -> None:
+        self.color: np.ndarray = raw["color"]
+        self.samples: Optional[np.ndarray] = raw["samples"]
+        self.sample_depth: Optional[np.ndarray] = raw["sample_depth"]
+        self.pattern: np.ndarray = raw["pattern"]
+        self.pattern_kind: str = raw["pattern_kind"]
+        self.stats: Dict[str, Union[int, float]] = raw["stats"]
+
+    @property
+    def width(self) -> int:
+        """Image width in pixels."""
+        return int(self.color.shape[1])
+
+    @property
+    def height(self) -> int:
+        """Image height in pixels."""
+        return int(self.color.shape[0])
+
+    @property
+    def spp(self) -> int:
+        """Samples per pixel."""
+        return int(self.pattern.shape[0])
+
+    def to_srgb8(self) -> np.ndarray:
+        """``(H, W, 4)`` uint8: straight-alpha sRGB colour, alpha linear (as a PNG stores it)."""
+        return _core.to_srgb8(self.color)
+
+    def save(self, path: Union[str, os.PathLike]) -> None:
+        """Writes :attr:`color`: ``.png`` as sRGB 8-bit (straight alpha), ``.exr`` as linear float.
+
+        Raises ValueError for another extension and OSError (with ``.filename``) when the file
+        cannot be written.
+        """
+        from .image import write_image
+
+        write_image(path, self.color)
+
+    def __repr__(self) -> str:
+        return (f"RenderResult({self.width}x{self.height}, spp={self.spp} {self.pattern_kind}, "
+                f"samples={'kept' if self.samples is not None else 'None'}, "
+                f"total_ms={self.stats['total_ms']:.3f})")
+
+
+def _int_in(value: Any, name: str, lo: int, hi: int, expected: str) -> int:
+    v = _checks.integer(value, name)
+    if not lo <= v <= hi:  # outside what C++ takes at all: say what C++ would say
+        raise ValueError(f"{name}: expected {expected}, got {v}")
+    return v
+
+
+def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, aa: str = "ssaa",
+           pattern: str = "auto", seed: int = 0, threads: int = 0, clear_color: Any = None,
+           keep_samples: bool = False) -> RenderResult:
+    """Renders ``scene`` through ``camera`` into a ``width`` × ``height`` image.
+
+    Args:
+        scene: the :class:`Scene` (draws are rendered in order).
+        camera: a :class:`Camera` (built for this size) or a ``mipraster._core.Camera``.
+        width, height: image size in pixels, 1…32768 each.
+        spp: samples per pixel, 1…64.
+        aa: ``"ssaa"`` shades every sample; ``"msaa"`` shades once per pixel per triangle.
+        pattern: ``"auto"`` (center for 1 sample, rotated for 4, grid otherwise), ``"center"``,
+            ``"grid"``, ``"rotated"`` (4 samples) or ``"stratified"`` (seeded jittered grid).
+        seed: seed of the stratified pattern, 0 ≤ seed < 2**64.
+        threads: worker threads, 0 = all cores. The image does not depend on it.
+        clear_color: background, linear premultiplied RGBA (3 components: alpha 1); None uses
+            ``scene.clear_color``, or transparent black when the scene has none.
+        keep_samples: also return every sample (and its depth) in ``samples`` / ``sample_depth``.
+
+    Returns:
+        A :class:`RenderResult`.
+
+    Raises:
+        TypeError: a wrong kind of argument.
+        ValueError: an unknown option name, a size, sample count or thread count out of range (the
+            C++ message), or a pattern that does not fit the sample count.
+
+    The GIL is released while the C++ renderer runs.
+    """
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene: expected a mipraster.Scene, got {type(scene).__name__}")
+    if not isinstance(camera, (Camera, _core.Camera)):
+        raise TypeError(f"camera: expected a mipraster.Camera, got {type(camera).__name__}")
+    w = _int_in(width, "width", _INT32_MIN, _INT32_MAX, f"1 to {_core.MAX_DIMENSION} pixels")
+    h = _int_in(height, "height", _INT32_MIN, _INT32_MAX, f"1 to {_core.MAX_DIMENSION} pixels")
+    samples = _int_in(spp, "spp", _INT32_MIN, _INT32_MAX, f"1 to {_core.MAX_SAMPLES}")
+    n_threads = _int_in(threads, "threads", _INT32_MIN, _INT32_MAX, f"0 (all cores) to {_core.MAX_THREADS}")
+    pattern_seed = _int_in(seed, "seed", 0, 2**64 - 1, "0 <= seed < 2**64")
+    anti_aliasing = _checks.choice(aa, "aa", ANTI_ALIASING)
+    pattern_kind = _checks.choice(pattern, "pattern", PATTERNS)
+    keep = _checks.flag(keep_samples, "keep_samples")
+    if clear_color is None:
+        clear_color = scene.clear_color if scene.clear_color is not None else (0.0, 0.0, 0.0, 0.0)
+    clear = _checks.rgba(clear_color, "clear_color")
+    draws = _core_draws(scene)
+
+    # The size first (the C++ message, before the camera divides by it), then the camera.
+    _core.validate_framebuffer_size(w, h, samples, any(d.depth_test for d in draws))
+    core_camera = camera.build(w, h) if isinstance(camera, Camera) else camera
+
+    settings = _core.RenderSettings()
+    settings.width, settings.height, settings.samples = w, h, samples
+    settings.anti_aliasing, settings.pattern, settings.pattern_seed = anti_aliasing, pattern_kind, pattern_seed
+    settings.threads, settings.clear_color, settings.keep_samples = n_threads, clear, keep
+    return RenderResult(_core.render(draws, core_camera, settings))

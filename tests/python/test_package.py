@@ -1,0 +1,85 @@
+"""The package itself: `import mipraster` loads no OpenImageIO (the _image module is imported on the
+first file access), the type stubs cover the extension modules, and public names are documented."""
+import ast
+import inspect
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+import mipraster as mr
+from mipraster import _core
+
+PACKAGE_DIR = pathlib.Path(mr.__file__).parent
+
+
+def run_python(code):
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    return r.stdout.split()
+
+
+def test_import_does_not_load_the_image_module_or_openimageio(tmp_path):
+    out = run_python(
+        "import sys, numpy as np, mipraster as mr\n"
+        "maps = lambda: open('/proc/self/maps').read()\n"
+        "print('mipraster._image' in sys.modules, 'libOpenImageIO' in maps(), 'mipraster/_core' in maps())\n"
+        "scene, camera = mr.Scene.demo()\n"
+        "result = mr.render(scene, camera, 16, 16)\n"
+        "result.to_srgb8()\n"
+        "print('mipraster._image' in sys.modules, 'libOpenImageIO' in maps())\n"
+        f"result.save({str(tmp_path / 'x.png')!r})\n"
+        "print('mipraster._image' in sys.modules, 'libOpenImageIO' in maps())\n"
+    )
+    # after import and a render: neither; after the first file write: both (the check can see them)
+    assert out == ["False", "False", "True", "False", "False", "True", "True"]
+
+
+def _stub_names(path):
+    tree = ast.parse(path.read_text())
+    top, members = set(), {}
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+            top.add(node.name)
+        elif isinstance(node, ast.AnnAssign):
+            top.add(node.target.id)
+        if isinstance(node, ast.ClassDef):
+            members[node.name] = {
+                (n.name if isinstance(n, ast.FunctionDef) else n.target.id)
+                for n in node.body if isinstance(n, (ast.FunctionDef, ast.AnnAssign))
+            }
+    return top, members
+
+
+@pytest.mark.parametrize("module_name", ["_core", "_image"])
+def test_stubs_cover_the_extension_modules(module_name):
+    module = __import__(f"mipraster.{module_name}", fromlist=["_"])
+    top, members = _stub_names(PACKAGE_DIR / f"{module_name}.pyi")
+    public = {n for n in dir(module) if not n.startswith("_")}
+    assert public == top - {n for n in top if n.startswith("_")}
+    for cls_name, stubbed in members.items():
+        cls = getattr(module, cls_name, None)
+        if cls is None or isinstance(getattr(cls, "__members__", None), dict):  # enums: values only
+            if cls is not None:
+                assert set(cls.__members__) <= stubbed, cls_name
+            continue
+        runtime = {n for n in dir(cls) if not n.startswith("_")}
+        assert runtime <= stubbed, (cls_name, runtime - stubbed)
+    assert (PACKAGE_DIR / "py.typed").exists()
+
+
+def test_public_api_is_documented():
+    assert mr.__doc__ and "import mipraster" in mr.__doc__
+    for name in mr.__all__:
+        obj = getattr(mr, name)
+        assert inspect.getdoc(obj), name
+        if inspect.isclass(obj):
+            for attr, value in vars(obj).items():
+                if not attr.startswith("_") and (callable(value) or isinstance(value, (property, classmethod))):
+                    assert inspect.getdoc(getattr(obj, attr)), f"{name}.{attr}"
+    assert _core.__doc__
+
+
+def test_version():
+    assert mr.__version__ == "0.1.0"

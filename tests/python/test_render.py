@@ -1,0 +1,285 @@
+"""mipraster.render against numpy oracles: exact coverage of axis-aligned rectangles (top-left rule,
+shared diagonals counted once), supersample coverage with the reported pattern, blending, culling;
+the result's arrays (zero copy), determinism across threads, the demo, and every error path."""
+import concurrent.futures
+import os
+import shutil
+import subprocess
+import sysconfig
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import mipraster as mr
+
+W, H = 24, 16
+
+
+def screen_camera(width=W, height=H):
+    """Orthographic camera where world (x, y) = screen (x − W/2, H/2 − y): 1 world unit per pixel."""
+    return mr.Camera.orthographic(eye=(0, 0, 5), target=(0, 0, 0), height=float(height), near=0.0, far=10.0)
+
+
+def rectangle(x0, y0, x1, y1, width=W, height=H, colors=None):
+    """Two triangles covering the screen rectangle [x0, x1] × [y0, y1] (pixels, y down)."""
+    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+    positions = [(x - width / 2, height / 2 - y, 0.0) for x, y in corners]
+    return mr.Mesh(positions, [[0, 1, 2], [0, 2, 3]], colors)
+
+
+def coverage_oracle(rects, offsets, width=W, height=H):
+    """Per pixel, the number of (rectangle, sample) pairs with the sample inside the rectangle, where
+    the left and top edges are inside and the right and bottom edges are not (the top-left rule)."""
+    count = np.zeros((height, width, len(offsets)))
+    ys, xs = np.mgrid[0:height, 0:width]
+    for s, (ox, oy) in enumerate(offsets):
+        sx, sy = xs + ox, ys + oy
+        for x0, y0, x1, y1 in rects:
+            count[..., s] += (x0 <= sx) & (sx < x1) & (y0 <= sy) & (sy < y1)
+    return count
+
+
+def test_rectangle_covers_exactly_the_expected_pixels_with_its_colour():
+    # Edges exactly on pixel centres: x = 2.5 (left: in), x = 9.5 (right: out), y = 3.5 (top: in),
+    # y = 11.5 (bottom: out).
+    scene = mr.Scene()
+    scene.add(rectangle(2.5, 3.5, 9.5, 11.5), color=(0.25, 0.5, 0.75, 1.0))
+    result = mr.render(scene, screen_camera(), W, H)
+    expected = np.zeros((H, W, 4), np.float32)
+    expected[3:11, 2:9] = [0.25, 0.5, 0.75, 1.0]
+    np.testing.assert_array_equal(result.color, expected)
+    assert result.stats["triangles_in"] == 2 and result.stats["triangles_rasterized"] == 2
+    assert result.stats["samples_covered"] == 8 * 7
+
+
+@pytest.mark.parametrize("spp, pattern, aa", [(1, "auto", "ssaa"), (4, "rotated", "msaa"), (16, "grid", "ssaa"),
+                                              (8, "stratified", "msaa"), (6, "grid", "msaa")])
+def test_additive_rectangles_count_coverage_like_the_oracle(spp, pattern, aa):
+    rng = np.random.default_rng(spp)
+    rects = []
+    for _ in range(12):
+        x = np.sort(rng.integers(-8, 8 * (W + 4), 2)) / 8  # multiples of 1/8 px, some off screen
+        y = np.sort(rng.integers(-8, 8 * (H + 4), 2)) / 8
+        if x[0] < x[1] and y[0] < y[1]:
+            rects.append((x[0], y[0], x[1], y[1]))
+    scene = mr.Scene()
+    for r in rects:
+        scene.add(rectangle(*r), blend="add", depth_test=False, color=(1, 1, 1, 1))
+    result = mr.render(scene, screen_camera(), W, H, spp=spp, pattern=pattern, aa=aa, seed=7, keep_samples=True)
+    assert result.pattern.shape == (spp, 2)
+    assert np.all((result.pattern >= 0) & (result.pattern < 1))
+    assert np.all(result.pattern * 256 == np.round(result.pattern * 256))
+    counts = coverage_oracle(rects, result.pattern)
+    np.testing.assert_array_equal(result.samples[..., 0], counts)
+    np.testing.assert_allclose(result.color[..., 0], counts.mean(axis=2), rtol=1e-6)
+    assert result.sample_depth is None  # no draw tests depth: no depth buffer
+
+
+def test_over_blending_and_clear_colour():
+    scene = mr.Scene()
+    scene.add(rectangle(0, 0, 12, 16), blend="over", color=(0.5, 0.0, 0.0, 0.5))  # premultiplied
+    result = mr.render(scene, screen_camera(), W, H, clear_color=(0.0, 0.0, 1.0))
+    np.testing.assert_array_equal(result.color[:, :12], np.broadcast_to([0.5, 0, 0.5, 1], (H, 12, 4)))
+    np.testing.assert_array_equal(result.color[:, 12:], np.broadcast_to([0, 0, 1, 1], (H, 12, 4)))
+    scene.clear_color = (0.0, 1.0, 0.0, 1.0)  # used when render() is given no clear colour
+    np.testing.assert_array_equal(mr.render(scene, screen_camera(), W, H).color[0, -1], [0, 1, 0, 1])
+
+
+def test_flat_interpolation_takes_the_first_vertex_colour():
+    colors = [[0.2, 0.4, 0.6], [1, 0, 0], [0, 1, 0], [0, 0, 1]]
+    scene = mr.Scene()
+    scene.add(rectangle(0, 0, W, H, colors=colors), interpolation="flat")
+    result = mr.render(scene, screen_camera(), W, H)
+    np.testing.assert_allclose(result.color.reshape(-1, 4), [[0.2, 0.4, 0.6, 1.0]] * (W * H), rtol=1e-6)
+    smooth = mr.Scene()
+    smooth.add(rectangle(0, 0, W, H, colors=colors), interpolation="screen")
+    assert len(np.unique(mr.render(smooth, screen_camera(), W, H).color.reshape(-1, 4), axis=0)) > 10
+
+
+def test_culling_uses_the_on_screen_winding():
+    # Counter-clockwise as seen by the viewer (world +x then +y, camera looking down -z): front.
+    ccw = mr.Mesh([[-4, -4, 0], [4, -4, 0], [0, 4, 0]], [[0, 1, 2]])
+    for cull, drawn in (("none", True), ("back", True), ("front", False)):
+        scene = mr.Scene()
+        scene.add(ccw, cull=cull)
+        result = mr.render(scene, screen_camera(), W, H)
+        assert (result.color[..., 3].sum() > 0) == drawn, cull
+        assert result.stats["triangles_backface"] == (0 if drawn else 1)
+
+
+# --- the result's arrays ------------------------------------------------------------------------------
+
+
+def test_color_is_the_renderers_buffer_not_a_copy_and_is_writable():
+    scene = mr.Scene()
+    scene.add(rectangle(1, 1, 5, 5))
+    result = mr.render(scene, screen_camera(), W, H, spp=4, keep_samples=True)
+    for array in (result.color, result.samples):
+        assert array.dtype == np.float32 and array.flags.c_contiguous
+        assert not array.flags.owndata  # numpy did not allocate it ...
+        assert type(array.base).__name__ == "PyCapsule"  # ... the C++ vector, owned by a capsule, holds it
+        assert array.flags.writeable
+    assert result.color.shape == (H, W, 4) and result.samples.shape == (H, W, 4, 4)
+    assert result.sample_depth.shape == (H, W, 4) and result.sample_depth.dtype == np.float32
+    result.color[0, 0] = 7.0
+    assert result.color[0, 0, 0] == 7.0
+    view = result.color[2:4]
+    del result
+    assert view.base.base is not None and view[0, 0, 3] == 0.0  # the buffer outlives the result
+
+
+def test_samples_resolve_to_the_colour_with_a_box_filter():
+    scene, camera = mr.Scene.demo()
+    result = mr.render(scene, camera, 40, 24, spp=5, pattern="stratified", aa="ssaa", keep_samples=True)
+    np.testing.assert_allclose(result.samples.mean(axis=2), result.color, rtol=1e-5, atol=1e-7)
+    assert np.all((result.sample_depth >= 0) & (result.sample_depth <= 1))  # reverse-Z window depth
+
+
+def test_stats_and_repr():
+    scene, camera = mr.Scene.demo()
+    result = mr.render(scene, camera, 32, 18, threads=2)
+    assert set(result.stats) == {
+        "triangles_in", "triangles_clipped", "triangles_outside", "triangles_backface", "triangles_degenerate",
+        "triangles_nonfinite", "triangles_rasterized", "samples_covered", "samples_passed",
+        "shader_invocations", "threads", "transform_ms", "setup_ms", "raster_ms", "total_ms"}
+    assert result.stats["triangles_in"] == sum(d.mesh.triangle_count for d in scene.draws)
+    assert result.stats["threads"] == 2
+    assert (result.width, result.height, result.spp, result.pattern_kind) == (32, 18, 1, "center")
+    assert repr(result).startswith("RenderResult(32x18, spp=1 center")
+    assert repr(scene).startswith("Scene(draws=2, triangles=")
+
+
+def test_thread_count_does_not_change_the_image():
+    scene, camera = mr.Scene.demo()
+    for kw in (dict(spp=4, aa="msaa"), dict(spp=8, aa="ssaa", pattern="stratified", seed=3)):
+        one = mr.render(scene, camera, 160, 96, threads=1, **kw)
+        two = mr.render(scene, camera, 160, 96, threads=2, **kw)
+        np.testing.assert_array_equal(one.color, two.color)
+
+
+def test_concurrent_renders_from_python_threads_agree():
+    scene, camera = mr.Scene.demo()
+    with concurrent.futures.ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(lambda _: mr.render(scene, camera, 64, 40, spp=4, threads=1).color, range(4)))
+    for r in results[1:]:
+        np.testing.assert_array_equal(r, results[0])
+
+
+def _cli():
+    for d in (sysconfig.get_path("scripts"), sysconfig.get_path("scripts", f"{os.name}_user")):
+        p = os.path.join(d, "mipraster")
+        if os.access(p, os.X_OK):
+            return p
+    return shutil.which("mipraster")
+
+
+def test_demo_matches_the_command_line_renderer(tmp_path):
+    exe = _cli()
+    assert exe, "the mipraster executable is not installed"
+    out = tmp_path / "cli.png"
+    subprocess.run([exe, "render", "-o", str(out), "--size", "96x64"], check=True, capture_output=True)
+    scene, camera = mr.Scene.demo()
+    result = mr.render(scene, camera, 96, 64, spp=4, aa="msaa")  # the command's defaults
+    np.testing.assert_array_equal(result.to_srgb8(), np.asarray(Image.open(out)))
+    assert result.color[..., 3].min() == 1.0  # sky and ground cover everything
+
+
+# --- errors -----------------------------------------------------------------------------------------------
+
+
+def one_draw_scene():
+    scene = mr.Scene()
+    scene.add(rectangle(1, 1, 5, 5))
+    return scene
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        (dict(blend="xor"), ["blend", "'xor'", "'replace'", "'add'", "'over'"]),
+        (dict(interpolation="linear"), ["interpolation", "'linear'", "'perspective'", "'screen'", "'flat'"]),
+        (dict(cull="cw"), ["cull", "'cw'", "'none'", "'back'", "'front'"]),
+        (dict(model=np.eye(3)), ["model", "(4, 4)", "(3, 3)"]),
+        (dict(model=np.diag([1, 1, np.nan, 1])), ["model[2, 2]", "nan"]),
+        (dict(color=(1, 1)), ["color", "(3,) or (4,)", "(2,)"]),
+        (dict(color=(1, np.inf, 1)), ["color[1]", "inf"]),
+    ],
+)
+def test_scene_add_refuses_bad_values(kwargs, words):
+    with pytest.raises(ValueError) as e:
+        mr.Scene().add(rectangle(0, 0, 1, 1), **kwargs)
+    for w in words:
+        assert w in str(e.value)
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        (dict(blend=None), ["blend"]),
+        (dict(depth_test="yes"), ["depth_test", "True or False"]),
+        (dict(depth_write=1), ["depth_write"]),
+    ],
+)
+def test_scene_add_refuses_wrong_types(kwargs, words):
+    with pytest.raises(TypeError) as e:
+        mr.Scene().add(rectangle(0, 0, 1, 1), **kwargs)
+    for w in words:
+        assert w in str(e.value)
+    with pytest.raises(TypeError, match="mesh: expected a mipraster.Mesh"):
+        mr.Scene().add(np.zeros((3, 3)))
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        # messages from C++ (std::invalid_argument -> ValueError)
+        (dict(width=0), "width: expected 1 to 32768 pixels, got 0"),
+        (dict(height=40000), "height: expected 1 to 32768 pixels, got 40000"),
+        (dict(spp=0), "samples per pixel: expected 1 to 64, got 0"),
+        (dict(spp=65), "samples per pixel: expected 1 to 64, got 65"),
+        (dict(width=30000, height=30000, spp=64), "MiB"),
+        (dict(spp=8, pattern="rotated"), "pattern 'rotated' has 4 samples; got samples=8"),
+        (dict(spp=2, pattern="center"), "pattern 'center' has 1 sample; got samples=2"),
+        (dict(threads=-1), "threads: expected 0 (all cores) to 256, got -1"),
+        (dict(threads=1000), "threads: expected 0 (all cores) to 256, got 1000"),
+        # checked in Python (C++ could not even take the value)
+        (dict(width=2**40), "width: expected 1 to 32768 pixels, got 1099511627776"),
+        (dict(seed=-1), "seed"),
+        (dict(aa="fxaa"), "aa: unknown value 'fxaa'; expected one of 'ssaa', 'msaa'"),
+        (dict(pattern="poisson"), "pattern: unknown value 'poisson'; expected one of 'auto', 'center', 'grid'"),
+        (dict(clear_color=(0, 0)), "clear_color"),
+    ],
+)
+def test_render_refuses_bad_settings_with_value_error(kwargs, message):
+    args = dict(width=W, height=H)
+    args.update(kwargs)
+    with pytest.raises(ValueError) as e:
+        mr.render(one_draw_scene(), screen_camera(), **args)
+    assert message in str(e.value)
+
+
+@pytest.mark.parametrize(
+    "args, kwargs, words",
+    [
+        ((None, "camera"), {}, ["scene", "NoneType"]),
+        (("scene", None), {}, ["camera", "NoneType"]),
+        (("scene", "camera"), dict(width=8.0), ["width", "integer", "float"]),
+        (("scene", "camera"), dict(spp=True), ["spp", "bool"]),
+        (("scene", "camera"), dict(keep_samples="no"), ["keep_samples"]),
+        (("scene", "camera"), dict(aa=4), ["aa"]),
+    ],
+)
+def test_render_refuses_wrong_types(args, kwargs, words):
+    values = {"scene": one_draw_scene(), "camera": screen_camera(), None: None}
+    call = dict(width=W, height=H)
+    call.update(kwargs)
+    with pytest.raises(TypeError) as e:
+        mr.render(values[args[0]], values[args[1]], **call)
+    for w in words:
+        assert w in str(e.value)
+
+
+def test_numpy_integers_are_accepted_for_sizes():
+    result = mr.render(one_draw_scene(), screen_camera(), np.int64(W), np.int32(H), spp=np.uint8(4))
+    assert result.color.shape == (H, W, 4) and result.spp == 4
