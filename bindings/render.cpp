@@ -1,6 +1,7 @@
 // Render bindings of mipraster._core: settings, sample patterns, the renderer, and the sRGB
 // encoding of its output (colour.hpp is part of the core library).
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <utility>
@@ -89,9 +90,37 @@ py::dict render_py(const py::sequence& draw_objects, const Camera& camera, const
         out["samples"] = vector_to_array(std::move(fb.color), {h, w, s, 4});
         if (fb.has_depth()) out["sample_depth"] = vector_to_array(std::move(fb.depth), {h, w, s});
     }
+    out["depth"] = py::none();
+    if (!result.depth.pixels.empty()) out["depth"] = vector_to_array(std::move(result.depth.pixels), {h, w});
     out["pattern"] = pattern_offsets(result.pattern);
     out["pattern_kind"] = to_string(result.pattern.kind);
     out["stats"] = stats_dict(result.stats);
+    return out;
+}
+
+// The primitive layer, with the GIL released. Positions and indices are copied into the C++
+// types (double clip coordinates, uint32 indices); the outputs are handed over without a copy.
+py::dict rasterize_py(const CArray<double>& pos_clip, const CArray<std::uint32_t>& triangles,
+                      const RasterizeSettings& settings) {
+    require_shape(pos_clip, {-1, 4}, "pos_clip");
+    require_shape(triangles, {-1, 3}, "triangles");
+    std::vector<glm::dvec4> positions(static_cast<std::size_t>(pos_clip.shape(0)));
+    std::memcpy(positions.data(), pos_clip.data(), positions.size() * sizeof(glm::dvec4));
+    std::vector<glm::uvec3> tris(static_cast<std::size_t>(triangles.shape(0)));
+    std::memcpy(tris.data(), triangles.data(), tris.size() * sizeof(glm::uvec3));
+    Visibility v;
+    {
+        py::gil_scoped_release release;
+        v = rasterize(positions, tris, settings);
+    }
+    const py::ssize_t h = v.height, w = v.width, s = v.samples;
+    py::dict out;
+    out["triangle_id"] = vector_to_array(std::move(v.triangle_id), {h, w, s});
+    out["barycentrics"] = vector_to_array(std::move(v.barycentrics), {h, w, s, 2});
+    out["depth"] = vector_to_array(std::move(v.depth), {h, w, s});
+    out["pattern"] = pattern_offsets(v.pattern);
+    out["pattern_kind"] = to_string(v.pattern.kind);
+    out["stats"] = stats_dict(v.stats);
     return out;
 }
 
@@ -142,7 +171,22 @@ void bind_render(py::module_& m) {
             [](RenderSettings& s, const CArray<float>& c) { s.clear_color = to_vec4(c, "clear_color"); },
             "premultiplied linear RGBA")
         .def_readwrite("keep_samples", &RenderSettings::keep_samples, "return the supersample framebuffer too")
+        .def_readwrite("depth_output", &RenderSettings::depth_output,
+                       "return each pixel's view-space depth (nearest sample, +inf where empty)")
         .def("__repr__", &RenderSettings::to_string);
+
+    py::class_<RasterizeSettings>(m, "RasterizeSettings", "Image size, sampling, depth convention and culling of rasterize().")
+        .def(py::init<>())
+        .def_readwrite("width", &RasterizeSettings::width)
+        .def_readwrite("height", &RasterizeSettings::height)
+        .def_readwrite("samples", &RasterizeSettings::samples, "samples per pixel, 1..64")
+        .def_readwrite("pattern", &RasterizeSettings::pattern)
+        .def_readwrite("pattern_seed", &RasterizeSettings::pattern_seed, "seed of the stratified pattern")
+        .def_readwrite("threads", &RasterizeSettings::threads, "0 = all hardware threads")
+        .def_readwrite("depth_convention", &RasterizeSettings::depth_convention,
+                       "opengl: -w <= z <= w, nearer is smaller; reverse_z: 0 <= z <= w, nearer is larger")
+        .def_readwrite("cull", &RasterizeSettings::cull)
+        .def("__repr__", &RasterizeSettings::to_string);
 
     m.def(
         "sample_pattern",
@@ -160,6 +204,12 @@ void bind_render(py::module_& m) {
           "Renders the draws in order (the GIL is released meanwhile). Returns a dict: color (H, W, 4)\n"
           "float32, samples (H, W, S, 4) and sample_depth (H, W, S) float32 or None, pattern (S, 2),\n"
           "pattern_kind and stats. The arrays own the renderer's buffers: nothing is copied.");
+
+    m.def("rasterize", &rasterize_py, py::arg("pos_clip"), py::arg("triangles"), py::arg("settings"),
+          "Clips and rasterizes clip-space triangles (the GIL is released meanwhile). Returns a dict:\n"
+          "triangle_id (H, W, S) int32 (-1 where empty), barycentrics (H, W, S, 2) float32 (perspective-\n"
+          "correct weights of each triangle's 2nd and 3rd vertex), depth (H, W, S) float32 window depth,\n"
+          "pattern (S, 2), pattern_kind and stats. Nothing is copied on the way out.");
 
     // --- colour ------------------------------------------------------------------------------------
     m.def("to_srgb8", &to_srgb8_py, py::arg("image"),

@@ -18,8 +18,9 @@ Conventions: right-handed world, the camera looks down −z with +y up; arrays a
 row 0 at the top; pixel (i, j) covers [i, i+1) × [j, j+1), its centre is (i + ½, j + ½); colour
 is linear premultiplied RGBA; the library's cameras use reverse-Z depth.
 
-The scene layer (:class:`Mesh`, :class:`Camera`, :class:`Scene`, :func:`render`) is pure Python
-over the C++ module ``mipraster._core``, which depends on nothing but the C++ standard library.
+The scene layer (:class:`Mesh`, :class:`Camera`, :class:`Scene`, :func:`render`) and the primitive
+layer (:func:`rasterize`, :func:`interpolate`, :func:`resolve`: bring your own clip-space
+positions) are Python over the C++ module ``mipraster._core``, which depends on nothing but the C++ standard library.
 Image files (:func:`read_image`, :func:`write_image`, :meth:`RenderResult.save`) use
 ``mipraster._image`` (OpenImageIO), imported on first use only, so ``import mipraster`` is fast.
 """
@@ -27,6 +28,7 @@ from ._core import linear_to_srgb, linear_to_srgb8, srgb_to_linear
 from .camera import Camera
 from .image import read_image, to_srgb8, write_image
 from .mesh import Mesh
+from .primitives import Raster, interpolate, rasterize, resolve
 from .render import RenderResult, render
 from .scene import Draw, Scene
 
@@ -36,12 +38,16 @@ __all__ = [
     "Camera",
     "Draw",
     "Mesh",
+    "Raster",
     "RenderResult",
     "Scene",
     "linear_to_srgb",
     "linear_to_srgb8",
+    "interpolate",
+    "rasterize",
     "read_image",
     "render",
+    "resolve",
     "srgb_to_linear",
     "to_srgb8",
     "write_image",

@@ -161,17 +161,32 @@ class RenderSettings:
     anti_aliasing: AntiAliasing
     threads: int
     keep_samples: bool
+    depth_output: bool
     def __init__(self) -> None: ...
     @property
     def clear_color(self) -> _RGBA: ...
     @clear_color.setter
     def clear_color(self, value: _ArrayLike) -> None: ...
 
+class RasterizeSettings:
+    width: int
+    height: int
+    samples: int
+    pattern: PatternKind
+    pattern_seed: int
+    threads: int
+    depth_convention: DepthConvention
+    cull: CullMode
+    def __init__(self) -> None: ...
+
 def sample_pattern(kind: PatternKind, samples: int, seed: int = 0) -> _Float64Array: ...
 def validate_framebuffer_size(width: int, height: int, samples: int, with_depth: bool) -> None: ...
 def render(draws: List[Draw], camera: Camera, settings: RenderSettings) -> Dict[str, Any]:
-    """Keys: color (H, W, 4) float32; samples (H, W, S, 4) float32 or None; sample_depth (H, W, S)
-    float32 or None; pattern (S, 2) float64; pattern_kind str; stats dict."""
+    """Keys: color (H, W, 4) float32; depth (H, W) float32 or None; samples (H, W, S, 4) float32 or
+    None; sample_depth (H, W, S) float32 or None; pattern (S, 2) float64; pattern_kind str; stats dict."""
+def rasterize(pos_clip: _ArrayLike, triangles: _ArrayLike, settings: RasterizeSettings) -> Dict[str, Any]:
+    """Keys: triangle_id (H, W, S) int32; barycentrics (H, W, S, 2) float32; depth (H, W, S) float32;
+    pattern (S, 2) float64; pattern_kind str; stats dict."""
 
 # --- colour ------------------------------------------------------------------------------------
 

@@ -34,6 +34,9 @@ class RenderResult:
         sample_depth: ``(H, W, S)`` float32 window depth of every sample when the render kept the
             samples and a draw tests depth, else None. Reverse-Z cameras: 1 at near, 0 at far/cleared;
             OpenGL-style matrices: z_ndc / 2 + ½, 1 cleared.
+        depth: ``(H, W)`` float32 view-space depth (distance along the viewing axis, −z in view
+            space) of each pixel's nearest sample, +inf where nothing was drawn; None when no draw
+            tests depth or the render was asked for no depth (``depth=False``).
         pattern: ``(S, 2)`` float64 sample offsets from the pixel's top-left corner, in pixels
             (multiples of 1/256).
         pattern_kind: the pattern used (``"center"``, ``"grid"``, ``"rotated"`` or ``"stratified"``).
@@ -44,10 +47,11 @@ class RenderResult:
             (``transform_ms``, ``setup_ms``, ``raster_ms``, ``total_ms``).
     """
 
-    __slots__ = ("color", "samples", "sample_depth", "pattern", "pattern_kind", "stats")
+    __slots__ = ("color", "depth", "samples", "sample_depth", "pattern", "pattern_kind", "stats")
 
     def __init__(self, raw: Dict[str, Any]) -> None:
         self.color: np.ndarray = raw["color"]
+        self.depth: Optional[np.ndarray] = raw["depth"]
         self.samples: Optional[np.ndarray] = raw["samples"]
         self.sample_depth: Optional[np.ndarray] = raw["sample_depth"]
         self.pattern: np.ndarray = raw["pattern"]
@@ -98,7 +102,7 @@ def _int_in(value: Any, name: str, lo: int, hi: int, expected: str) -> int:
 
 def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, aa: str = "ssaa",
            pattern: str = "auto", seed: int = 0, threads: int = 0, clear_color: Any = None,
-           keep_samples: bool = False) -> RenderResult:
+           keep_samples: bool = False, depth: bool = True) -> RenderResult:
     """Renders ``scene`` through ``camera`` into a ``width`` × ``height`` image.
 
     Args:
@@ -114,6 +118,8 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
         clear_color: background, linear premultiplied RGBA (3 components: alpha 1); None uses
             ``scene.clear_color``, or transparent black when the scene has none.
         keep_samples: also return every sample (and its depth) in ``samples`` / ``sample_depth``.
+        depth: return each pixel's view-space depth in ``depth`` (cheap; needs a projection whose
+            z and w rows depend on view-space z only, as every perspective and orthographic one does).
 
     Returns:
         A :class:`RenderResult`.
@@ -137,6 +143,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     anti_aliasing = _checks.choice(aa, "aa", ANTI_ALIASING)
     pattern_kind = _checks.choice(pattern, "pattern", PATTERNS)
     keep = _checks.flag(keep_samples, "keep_samples")
+    depth_output = _checks.flag(depth, "depth")
     if clear_color is None:
         clear_color = scene.clear_color if scene.clear_color is not None else (0.0, 0.0, 0.0, 0.0)
     clear = _checks.rgba(clear_color, "clear_color")
@@ -150,4 +157,5 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     settings.width, settings.height, settings.samples = w, h, samples
     settings.anti_aliasing, settings.pattern, settings.pattern_seed = anti_aliasing, pattern_kind, pattern_seed
     settings.threads, settings.clear_color, settings.keep_samples = n_threads, clear, keep
+    settings.depth_output = depth_output
     return RenderResult(_core.render(draws, core_camera, settings))
