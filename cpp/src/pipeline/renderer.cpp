@@ -345,12 +345,7 @@ Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::v
                                             std::to_string(clip_positions[i][c]) + "; expected a finite number");
     if (triangles.size() >= (std::size_t{1} << 31))
         throw std::invalid_argument("triangles: at most 2^31 - 1 triangles (ids are int32)");
-    for (std::size_t t = 0; t < triangles.size(); ++t)
-        for (int k = 0; k < 3; ++k)
-            if (triangles[t][k] >= clip_positions.size())
-                throw std::invalid_argument("triangles[" + std::to_string(t) + "][" + std::to_string(k) + "] = " +
-                                            std::to_string(triangles[t][k]) + " is out of range; expected < " +
-                                            std::to_string(clip_positions.size()) + " (the vertex count)");
+    validate_triangle_indices(triangles, clip_positions.size(), "triangles");
     const int threads = resolve_thread_count(settings.threads);
     ThreadPool pool(threads);
     RenderStats& stats = out.stats;

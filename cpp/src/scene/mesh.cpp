@@ -24,12 +24,17 @@ void Mesh::validate(const std::string& name) const {
             if (!std::isfinite(colors[i][c]))
                 throw std::invalid_argument(name + ".colors[" + std::to_string(i) + "]." + kChannel[c] +
                                             " is " + std::to_string(colors[i][c]) + "; expected a finite number");
+    validate_triangle_indices(triangles, positions.size(), name + ".triangles");
+}
+
+void validate_triangle_indices(const std::vector<glm::uvec3>& triangles, std::size_t vertex_count,
+                               const std::string& name) {
     for (std::size_t t = 0; t < triangles.size(); ++t)
         for (int k = 0; k < 3; ++k)
-            if (triangles[t][k] >= positions.size())
-                throw std::invalid_argument(name + ".triangles[" + std::to_string(t) + "][" + std::to_string(k) +
-                                            "] = " + std::to_string(triangles[t][k]) + " is out of range; expected < " +
-                                            std::to_string(positions.size()) + " (the vertex count)");
+            if (triangles[t][k] >= vertex_count)
+                throw std::invalid_argument(name + "[" + std::to_string(t) + "][" + std::to_string(k) + "] = " +
+                                            std::to_string(triangles[t][k]) + " is out of range; expected < " +
+                                            std::to_string(vertex_count) + " (the vertex count)");
 }
 
 std::string Mesh::to_string() const {

@@ -25,4 +25,8 @@ struct Mesh {
     std::string to_string() const;
 };
 
+/// Throws std::invalid_argument naming the first index ≥ vertex_count as `name`[t][corner].
+void validate_triangle_indices(const std::vector<glm::uvec3>& triangles, std::size_t vertex_count,
+                               const std::string& name);
+
 }  // namespace mipraster
