@@ -1,12 +1,18 @@
 // mipraster — the command-line renderer.
 //
 //   mipraster render -o OUT.png [--size WxH] [--spp N] [--aa ssaa|msaa] [--pattern NAME]
-//                    [--threads N] [--stats]
+//                    [--look-at EX,EY,EZ,TX,TY,TZ] [--fov DEG] [--threads N]
+//                    [--stats] [--stats-json PATH] [--quiet]
 //
 // With no scene file (scene files arrive with the Python/scene issue) it renders the built-in
 // demo. Usage errors exit with status 2, failures with 1; every message names the bad input.
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -35,8 +41,12 @@ constexpr const char* kUsage =
     "  --aa ssaa|msaa        shade every sample, or once per pixel per triangle [msaa]\n"
     "  --pattern NAME        auto, center, grid, rotated, stratified           [auto]\n"
     "  --seed N              seed of the stratified pattern                    [0]\n"
+    "  --look-at E,T         camera eye and target: EX,EY,EZ,TX,TY,TZ (+y up)   [the demo's]\n"
+    "  --fov DEG             vertical field of view in degrees                  [51.6]\n"
     "  --threads N           worker threads, 0 = all cores                     [0]\n"
     "  --stats               print triangle, sample and per-stage time counts\n"
+    "  --stats-json PATH     write the counts and times as JSON (- = stdout)\n"
+    "  --quiet               print nothing but errors (no summary, no progress bar)\n"
     "\n"
     "  mipraster --help | --version\n";
 
@@ -57,11 +67,53 @@ int parse_int(const std::string& option, const std::string& text) {
     return static_cast<int>(value);
 }
 
+double parse_number(const std::string& option, const std::string& text) {
+    std::size_t used = 0;
+    double value = 0;
+    try {
+        value = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != text.size() || text.empty() || !std::isfinite(value))
+        throw UsageError(option + ": expected a finite number, got '" + text + "'");
+    return value;
+}
+
+// "a,b,c,..." with exactly `count` finite numbers.
+std::vector<double> parse_numbers(const std::string& option, const std::string& text, std::size_t count) {
+    std::vector<double> values;
+    std::size_t start = 0;
+    for (;;) {
+        const std::size_t comma = text.find(',', start);
+        values.push_back(parse_number(option, text.substr(start, comma - start)));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    if (values.size() != count)
+        throw UsageError(option + ": expected " + std::to_string(count) + " comma-separated numbers, got '" + text + "'");
+    return values;
+}
+
 struct RenderOptions {
     std::string output;
     RenderSettings settings;
     bool print_stats = false;
+    std::string stats_json;  ///< path, "-" for stdout, empty for none
+    bool quiet = false;
+    std::vector<double> look_at;  ///< empty: the demo's camera
+    double fov_degrees = 0.0;     ///< 0: the demo's
 };
+
+// A progress bar on stderr, redrawn as tiles finish.
+void draw_progress(std::size_t done, std::size_t total) {
+    constexpr int kWidth = 30;
+    const int filled = static_cast<int>(kWidth * done / total);
+    std::fprintf(stderr, "\rrendering [%.*s%*s] %3d%%", filled, "##############################", kWidth - filled, "",
+                 static_cast<int>(100 * done / total));
+    if (done == total) std::fputs("\r\033[K", stderr);  // erase the bar when done
+    std::fflush(stderr);
+}
 
 RenderOptions parse_render_options(const std::vector<std::string>& args) {
     RenderOptions o;
@@ -93,8 +145,18 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
             o.settings.pattern_seed = static_cast<std::uint64_t>(parse_int(a, value()));
         } else if (a == "--threads") {
             o.settings.threads = parse_int(a, value());
+        } else if (a == "--look-at") {
+            o.look_at = parse_numbers(a, value(), 6);
+        } else if (a == "--fov") {
+            o.fov_degrees = parse_number(a, value());
+            if (!(o.fov_degrees > 0.0 && o.fov_degrees < 180.0))
+                throw UsageError("--fov: expected degrees in (0, 180), got " + args[i]);
         } else if (a == "--stats") {
             o.print_stats = true;
+        } else if (a == "--stats-json") {
+            o.stats_json = value();
+        } else if (a == "--quiet") {
+            o.quiet = true;
         } else {
             throw UsageError("render: unknown option '" + a + "'");
         }
@@ -107,15 +169,33 @@ int run_render(const std::vector<std::string>& args) {
     const RenderOptions o = parse_render_options(args);
     // Check the size before the scene is built from its aspect ratio.
     validate_framebuffer_size(o.settings.width, o.settings.height, o.settings.samples, true);
-    const DemoScene scene = make_demo_scene(static_cast<double>(o.settings.width) / o.settings.height);
+    const double aspect = static_cast<double>(o.settings.width) / o.settings.height;
+    const DemoScene scene = make_demo_scene(aspect);
+    Camera camera = scene.camera;
+    if (!o.look_at.empty() || o.fov_degrees > 0.0) {
+        const glm::dvec3 eye = o.look_at.empty() ? scene.eye : glm::dvec3(o.look_at[0], o.look_at[1], o.look_at[2]);
+        const glm::dvec3 target = o.look_at.empty() ? scene.target : glm::dvec3(o.look_at[3], o.look_at[4], o.look_at[5]);
+        const double fovy = o.fov_degrees > 0.0 ? o.fov_degrees * M_PI / 180.0 : scene.fovy;
+        camera = Camera::look_at_perspective(eye, target, {0, 1, 0}, fovy, aspect, scene.near);
+    }
     RenderSettings settings = o.settings;
     settings.clear_color = scene.clear_color;
-    const RenderResult result = render(scene.draws, scene.camera, settings);
+    if (!o.quiet && isatty(STDOUT_FILENO)) settings.progress = draw_progress;
+    const RenderResult result = render(scene.draws, camera, settings);
     write_image(o.output, result.color);
-    std::printf("wrote %s (%dx%d, %d spp %s, %.1f ms on %d threads)\n", o.output.c_str(), settings.width,
-                settings.height, settings.samples, to_string(settings.anti_aliasing).c_str(), result.stats.total_ms,
-                result.stats.threads);
+    if (!o.quiet)
+        std::printf("wrote %s (%dx%d, %d spp %s, %.1f ms on %d threads)\n", o.output.c_str(), settings.width,
+                    settings.height, settings.samples, to_string(settings.anti_aliasing).c_str(), result.stats.total_ms,
+                    result.stats.threads);
     if (o.print_stats) std::printf("%s\n%s\n", result.pattern.to_string().c_str(), result.stats.to_string().c_str());
+    if (o.stats_json == "-") {
+        std::printf("%s\n", result.stats.to_json().c_str());
+    } else if (!o.stats_json.empty()) {
+        std::FILE* f = std::fopen(o.stats_json.c_str(), "w");
+        if (!f) throw std::runtime_error("cannot write " + o.stats_json + ": " + std::strerror(errno));
+        std::fprintf(f, "%s\n", result.stats.to_json().c_str());
+        std::fclose(f);
+    }
     return 0;
 }
 

@@ -296,3 +296,40 @@ TEST(Renderer, EmptyDrawListRendersTheClearColour) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Renderer, ProgressReportsEveryTileOnceInIncreasingOrderEndingAtTheTotal) {
+    const mr::Mesh ok = small_mesh();
+    for (int threads : {1, 3}) {
+        auto s = settings(100, 70, 4);  // 4 × 3 tiles of 32 px, the last ones partial
+        s.threads = threads;
+        std::vector<std::pair<std::size_t, std::size_t>> calls;
+        s.progress = [&](std::size_t done, std::size_t total) { calls.emplace_back(done, total); };
+        mr::render({make_draw(ok, glm::dmat4(1.0), mr::DrawState{})}, mr::Camera{}, s);
+        ASSERT_EQ(calls.size(), 12u) << threads;
+        for (std::size_t i = 0; i < calls.size(); ++i) {
+            EXPECT_EQ(calls[i].first, i + 1);
+            EXPECT_EQ(calls[i].second, 12u);
+        }
+    }
+}
+
+TEST(Renderer, StatsJsonHoldsEveryCounter) {
+    mr::RenderStats st;
+    st.triangles_in = 7;
+    st.samples_passed = 123456789012ull;
+    st.total_ms = 1.5;
+    const std::string j = st.to_json();
+    EXPECT_EQ(j.front(), '{');
+    EXPECT_EQ(j.back(), '}');
+    EXPECT_NE(j.find("\"triangles_in\": 7,"), std::string::npos) << j;
+    EXPECT_NE(j.find("\"samples_passed\": 123456789012,"), std::string::npos) << j;
+    EXPECT_NE(j.find("\"total_ms\": 1.500"), std::string::npos) << j;
+    for (const char* key : {"triangles_clipped", "triangles_outside", "triangles_backface", "triangles_degenerate",
+                            "triangles_nonfinite", "triangles_rasterized", "samples_covered", "shader_invocations",
+                            "threads", "transform_ms", "setup_ms", "raster_ms"})
+        EXPECT_NE(j.find(std::string("\"") + key + "\": "), std::string::npos) << key;
+}
+
+}  // namespace

@@ -107,6 +107,54 @@ def test_unsupported_extension_is_refused(tmp_path):
     assert r.returncode != 0 and "x.bmpx" in r.stderr
 
 
+def test_stats_json_reports_the_counts_to_stdout_or_a_file(tmp_path):
+    import json
+
+    r = run("render", "-o", str(tmp_path / "a.png"), "--size", "64x36", "--stats-json", "-", "--quiet")
+    assert r.returncode == 0, r.stderr
+    stats = json.loads(r.stdout)  # --quiet: the JSON is the only output
+    assert stats["triangles_in"] == 51212  # the demo: 160x160 checker quads + 6 cube faces, 2 triangles each
+    assert stats["samples_covered"] > 0 and stats["total_ms"] > 0
+    out = tmp_path / "stats.json"
+    r = run("render", "-o", str(tmp_path / "b.png"), "--size", "64x36", "--stats-json", str(out))
+    assert r.returncode == 0, r.stderr
+    assert json.loads(out.read_text())["triangles_in"] == 51212
+
+
+def test_quiet_prints_nothing(tmp_path):
+    r = run("render", "-o", str(tmp_path / "q.png"), "--size", "32x32", "--quiet")
+    assert r.returncode == 0 and r.stdout == "" and r.stderr == ""
+    assert (tmp_path / "q.png").exists()
+
+
+def test_look_at_and_fov_move_the_camera(tmp_path):
+    base = render_png(tmp_path, "base.png", "--size", "96x54")
+    # The demo's own eye, target and field of view reproduce the default image exactly.
+    same = render_png(tmp_path, "same.png", "--size", "96x54", "--look-at", "5.5,4,5.5,0,0.8,0", "--fov",
+                      str(0.9 * 180 / np.pi))
+    assert np.array_equal(base, same)
+    moved = render_png(tmp_path, "moved.png", "--size", "96x54", "--look-at", "0,1.5,6,0,1,0")
+    narrow = render_png(tmp_path, "narrow.png", "--size", "96x54", "--fov", "20")
+    assert not np.array_equal(base, moved) and not np.array_equal(base, narrow)
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--look-at", "1,2,3"], ["--look-at", "6"]),
+        (["--look-at", "1,2,3,4,5,x"], ["--look-at", "x"]),
+        (["--look-at", "1,2,3,1,2,3"], ["eye", "target"]),
+        (["--fov", "0"], ["--fov"]),
+        (["--fov", "nan"], ["--fov", "nan"]),
+    ],
+)
+def test_bad_camera_options_exit_2_naming_them(tmp_path, args, words):
+    r = run("render", "-o", str(tmp_path / "x.png"), *args)
+    assert r.returncode == 2
+    for w in words:
+        assert w in r.stderr
+
+
 def test_help_and_version():
     r = run("--help")
     assert r.returncode == 0 and "render" in r.stdout and "--spp" in r.stdout

@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
+#include <type_traits>
 
 #include "mipraster/core/constants.hpp"
 #include "mipraster/core/thread_pool.hpp"
@@ -296,6 +298,8 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                      draws[d].state.depth_write};
     }
     std::vector<TileCounters> tile_counters(static_cast<std::size_t>(grid.count()));
+    std::mutex progress_mutex;
+    std::size_t tiles_done = 0;
     pool.parallel_for(static_cast<std::size_t>(grid.count()), [&](std::size_t tile) {
         TileTarget target = tile_target(grid, tile, result.pattern);
         // Tile-local storage, reused by each worker thread from tile to tile.
@@ -323,6 +327,10 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         if (depth_output)
             resolve_view_depth(target.depth, target.x0, target.y0, target.x1, target.y1, clear_depth, decoder,
                                result.depth);
+        if (settings.progress) {
+            std::lock_guard<std::mutex> lock(progress_mutex);
+            settings.progress(++tiles_done, static_cast<std::size_t>(grid.count()));
+        }
     });
     add_counters(tile_counters, stats);
     if (settings.keep_samples) result.framebuffer = std::move(kept);
@@ -415,6 +423,27 @@ std::string RenderSettings::to_string() const {
            std::to_string(samples) + ", pattern=" + mipraster::to_string(pattern) + ", aa=" +
            mipraster::to_string(anti_aliasing) + ", threads=" + std::to_string(threads) + ", resolve=" +
            mipraster::to_string(resolve_filter) + ")";
+}
+
+std::string RenderStats::to_json() const {
+    auto field = [](const char* name, auto value, bool last = false) {
+        std::string v;
+        if constexpr (std::is_floating_point_v<decltype(value)>) {
+            char buf[32];
+            std::snprintf(buf, sizeof buf, "%.3f", value);
+            v = buf;
+        } else {
+            v = std::to_string(value);
+        }
+        return std::string("\"") + name + "\": " + v + (last ? "" : ", ");
+    };
+    return "{" + field("triangles_in", triangles_in) + field("triangles_clipped", triangles_clipped) +
+           field("triangles_outside", triangles_outside) + field("triangles_backface", triangles_backface) +
+           field("triangles_degenerate", triangles_degenerate) + field("triangles_nonfinite", triangles_nonfinite) +
+           field("triangles_rasterized", triangles_rasterized) + field("samples_covered", samples_covered) +
+           field("samples_passed", samples_passed) + field("shader_invocations", shader_invocations) +
+           field("threads", threads) + field("transform_ms", transform_ms) + field("setup_ms", setup_ms) +
+           field("raster_ms", raster_ms) + field("total_ms", total_ms, true) + "}";
 }
 
 std::string RenderStats::to_string() const {

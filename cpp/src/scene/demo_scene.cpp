@@ -85,7 +85,11 @@ DemoScene make_demo_scene(double aspect) {
                          glm::dvec4(0, 0, 0, 1)),  // 30° about y
               glm::vec4(1.0f), state};
     s.draws = {ground, cube};
-    s.camera = Camera::look_at_perspective({5.5, 4.0, 5.5}, {0.0, 0.8, 0.0}, {0, 1, 0}, 0.9, aspect, 0.05);
+    s.eye = {5.5, 4.0, 5.5};
+    s.target = {0.0, 0.8, 0.0};
+    s.fovy = 0.9;
+    s.near = 0.05;
+    s.camera = Camera::look_at_perspective(s.eye, s.target, {0, 1, 0}, s.fovy, aspect, s.near);
     s.clear_color = glm::vec4(0.35f, 0.55f, 0.85f, 1.0f);
     return s;
 }

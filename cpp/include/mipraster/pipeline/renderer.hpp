@@ -1,6 +1,8 @@
 #pragma once
 // The pipeline driver: vertex transform → clip → setup → bin → rasterize tiles → resolve.
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -33,6 +35,9 @@ struct RenderSettings {
     ResolveFilter resolve_filter = ResolveFilter::box;
     bool keep_samples = false;                      ///< return the supersample framebuffer too
     bool depth_output = false;                      ///< return RenderResult::depth (when some draw tests depth)
+    /// Called as tiles finish with (tiles done, tiles in all); calls are serialized (never
+    /// concurrent) but may come from any worker thread. Empty: no progress reports.
+    std::function<void(std::size_t, std::size_t)> progress;
 
     std::string to_string() const;
 };
@@ -55,6 +60,8 @@ struct RenderStats {
     double total_ms = 0;
 
     std::string to_string() const;
+    /// The counters and times as a JSON object.
+    std::string to_json() const;
 };
 
 struct RenderResult {

@@ -12,7 +12,10 @@ namespace mipraster {
 struct DemoScene {
     std::vector<std::shared_ptr<Mesh>> meshes;  ///< owned here; draws point into them
     std::vector<Draw> draws;
-    Camera camera;
+    Camera camera;          ///< look_at_perspective(eye, target, +y, fovy, aspect, near)
+    glm::dvec3 eye, target;
+    double fovy = 0.0;      ///< vertical field of view, radians
+    double near = 0.0;
     glm::vec4 clear_color;  ///< sky colour, linear premultiplied
 };
 
