@@ -23,9 +23,14 @@ layer (:func:`rasterize`, :func:`interpolate`, :func:`resolve`: bring your own c
 positions) are Python over the C++ module ``mipraster._core``, which depends on nothing but the C++ standard library.
 Image files (:func:`read_image`, :func:`write_image`, :meth:`RenderResult.save`) use
 ``mipraster._image`` (OpenImageIO), imported on first use only, so ``import mipraster`` is fast.
+
+:func:`compare` compares two images value by value with thresholds (OpenImageIO ``idiff`` style) and
+returns a :class:`CompareReport`; :mod:`mipraster.testing` (imported explicitly) builds golden-image
+tests on it.
 """
 from ._core import linear_to_srgb, linear_to_srgb8, srgb_to_linear
 from .camera import Camera
+from .compare import CompareReport, compare
 from .image import read_image, to_srgb8, write_image
 from .mesh import Mesh
 from .primitives import Raster, interpolate, rasterize, resolve
@@ -36,11 +41,13 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Camera",
+    "CompareReport",
     "Draw",
     "Mesh",
     "Raster",
     "RenderResult",
     "Scene",
+    "compare",
     "linear_to_srgb",
     "linear_to_srgb8",
     "interpolate",
