@@ -155,6 +155,47 @@ def test_bad_camera_options_exit_2_naming_them(tmp_path, args, words):
         assert w in r.stderr
 
 
+def test_compare_passes_identical_images_and_fails_different_ones(tmp_path):
+    a, b = tmp_path / "a.png", tmp_path / "b.png"
+    assert run("render", "-o", str(a), "--size", "64x36", "--quiet").returncode == 0
+    assert run("render", "-o", str(b), "--size", "64x36", "--spp", "1", "--quiet").returncode == 0
+    same = run("compare", str(a), str(a))
+    assert same.returncode == 0 and same.stdout.splitlines()[1] == "PASS"
+    differ = run("compare", str(a), str(b))
+    assert differ.returncode == 1 and "FAIL" in differ.stdout and "PSNR" in differ.stdout
+    # The antialiased and aliased demo differ only at edges: a loose enough threshold passes.
+    loose = run("compare", str(a), str(b), "--fail-fraction", "0.5", "--hard-fail", "1")
+    assert loose.returncode == 0, loose.stdout
+
+
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        (["missing.png"], ["missing.png"]),
+        ([], ["two image paths"]),
+        (["--fail", "-1", "X"], ["fail_threshold"]),
+        (["--fail-fraction", "2", "X"], ["fail_fraction"]),
+        (["--bogus", "X"], ["--bogus"]),
+    ],
+)
+def test_compare_that_cannot_compare_exits_2(tmp_path, extra, words):
+    a = tmp_path / "a.png"
+    assert run("render", "-o", str(a), "--size", "16x16", "--quiet").returncode == 0
+    args = [str(tmp_path / w) if w.endswith(".png") else (str(a) if w == "X" else w) for w in extra]
+    r = run("compare", str(a), *args)
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    for w in words:
+        assert w in r.stderr
+
+
+def test_compare_refuses_images_of_different_sizes(tmp_path):
+    a, b = tmp_path / "a.png", tmp_path / "b.png"
+    run("render", "-o", str(a), "--size", "16x16", "--quiet")
+    run("render", "-o", str(b), "--size", "16x8", "--quiet")
+    r = run("compare", str(a), str(b))
+    assert r.returncode == 2 and "16x16" in r.stderr and "16x8" in r.stderr
+
+
 def test_help_and_version():
     r = run("--help")
     assert r.returncode == 0 and "render" in r.stdout and "--spp" in r.stdout
