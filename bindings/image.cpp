@@ -1,14 +1,17 @@
 // mipraster._image: image files through mipraster_io (OpenImageIO). A separate module so that
 // `import mipraster` stays fast; the Python layer imports it the first time a file is read or written.
+// Scene files (OBJ, glTF) load here too: mipraster_io is the module that holds the file formats.
 #include <stdexcept>
 #include <string>
 #include <utility>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include "common.hpp"
 #include "mipraster/io/image_io.hpp"
+#include "mipraster/io/scene_file.hpp"
 
 namespace mipraster::bindings {
 
@@ -53,6 +56,60 @@ void write_image_py(const std::string& path, const CArray<float>& array) {
     if (!failure.empty()) raise_os_error(failure, path);
 }
 
+// load_scene as plain Python data (numpy arrays, dicts, NamedCamera objects): the Python layer
+// turns it into mipraster.Mesh / Scene / Camera objects (those types live in _core).
+py::dict load_scene_py(const std::string& path) {
+    LoadedScene scene;
+    std::string failure;
+    {
+        py::gil_scoped_release release;
+        try {
+            scene = load_scene(path);  // std::invalid_argument (extension, geometry) → ValueError
+        } catch (const std::runtime_error& e) {
+            failure = e.what();
+            if (failure.empty()) failure = "load_scene: cannot read '" + path + "'";
+        }
+    }
+    if (!failure.empty()) raise_os_error(failure, path);
+
+    py::list meshes;
+    for (const auto& mesh : scene.meshes) {
+        std::vector<float> positions(mesh->positions.size() * 3), colors(mesh->colors.size() * 4);
+        std::vector<std::uint32_t> triangles(mesh->triangles.size() * 3);
+        for (std::size_t i = 0; i < mesh->positions.size(); ++i)
+            for (int c = 0; c < 3; ++c) positions[3 * i + c] = mesh->positions[i][c];
+        for (std::size_t i = 0; i < mesh->colors.size(); ++i)
+            for (int c = 0; c < 4; ++c) colors[4 * i + c] = mesh->colors[i][c];
+        for (std::size_t i = 0; i < mesh->triangles.size(); ++i)
+            for (int c = 0; c < 3; ++c) triangles[3 * i + c] = mesh->triangles[i][c];
+        const auto n = static_cast<py::ssize_t>(mesh->positions.size());
+        const auto t = static_cast<py::ssize_t>(mesh->triangles.size());
+        py::object cols = py::none();
+        if (!mesh->colors.empty()) cols = vector_to_array(std::move(colors), {n, 4});
+        meshes.append(py::make_tuple(vector_to_array(std::move(positions), {n, 3}),
+                                     vector_to_array(std::move(triangles), {t, 3}), cols));
+    }
+    py::list draws;
+    for (const Draw& d : scene.draws) {
+        std::size_t index = 0;
+        while (index < scene.meshes.size() && scene.meshes[index].get() != d.mesh) ++index;
+        if (index == scene.meshes.size()) throw std::logic_error("load_scene: a draw's mesh is not among the scene's meshes");
+        py::dict draw;
+        draw["mesh"] = index;
+        draw["model"] = from_dmat4(d.model);
+        draw["color"] = from_vec4(d.color);
+        draw["blend"] = to_string(d.state.blend);
+        draw["cull"] = to_string(d.state.cull);
+        draws.append(draw);
+    }
+    py::dict out;
+    out["meshes"] = meshes;
+    out["draws"] = draws;
+    out["cameras"] = py::cast(scene.cameras);
+    out["warnings"] = py::cast(scene.warnings);
+    return out;
+}
+
 }  // namespace
 
 }  // namespace mipraster::bindings
@@ -68,4 +125,29 @@ PYBIND11_MODULE(_image, m) {
           "Writes (H, W, C) float32 (C = 1, 3 or 4; 4 = linear premultiplied RGBA) or (H, W): .png is sRGB\n"
           "8-bit with straight alpha (1 channel: plain grey), .exr is linear float as given. ValueError for\n"
           "another extension or a malformed image, OSError (with .filename) when the file cannot be written.");
+
+    using mipraster::NamedCamera;
+    py::class_<NamedCamera>(m, "NamedCamera",
+                            "A camera from a scene file, kept as parameters (the projection needs the image aspect).")
+        .def_readonly("name", &NamedCamera::name)
+        .def_property_readonly("projection", [](const NamedCamera& c) { return to_string(c.projection); },
+                               "'perspective' or 'orthographic'")
+        .def_readonly("yfov", &NamedCamera::yfov, "perspective: vertical field of view, radians")
+        .def_readonly("aspect_ratio", &NamedCamera::aspect_ratio, "perspective: the file's width/height, 0 = the image's")
+        .def_readonly("xmag", &NamedCamera::xmag, "orthographic: half width")
+        .def_readonly("ymag", &NamedCamera::ymag, "orthographic: half height")
+        .def_readonly("znear", &NamedCamera::znear)
+        .def_readonly("zfar", &NamedCamera::zfar, "inf for an infinite perspective")
+        .def_property_readonly("view", [](const NamedCamera& c) { return from_dmat4(c.view); },
+                               "4x4 world -> view matrix (a copy)")
+        .def(
+            "projection_matrix", [](const NamedCamera& c, double aspect) { return from_dmat4(c.build(aspect).projection); },
+            py::arg("aspect"), "The reverse-Z projection for an image of the given aspect (width / height).")
+        .def("__repr__", &NamedCamera::to_string);
+    m.def("load_scene", &load_scene_py, py::arg("path"),
+          "Loads a scene file (.obj, .gltf, .glb) into plain data: a dict with 'meshes' (list of\n"
+          "(positions (N, 3) float32, triangles (T, 3) uint32, colors (N, 4) float32 or None)), 'draws'\n"
+          "(list of dicts: mesh index, model 4x4, color RGBA, blend and cull names), 'cameras' (list of\n"
+          "NamedCamera) and 'warnings' (list of str). Textures are skipped. OSError (with .filename) for a\n"
+          "missing, unreadable or corrupt file; ValueError for an unsupported extension or bad geometry.");
 }

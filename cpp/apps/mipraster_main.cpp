@@ -1,12 +1,12 @@
 // mipraster — the command-line renderer.
 //
 //   mipraster compare A B [--fail T] [--fail-fraction F] [--hard-fail H]
-//   mipraster render -o OUT.png [--size WxH] [--spp N] [--aa ssaa|msaa] [--pattern NAME]
+//   mipraster render [SCENE] -o OUT.png [--camera N] [--size WxH] [--spp N] [--aa ssaa|msaa] [--pattern NAME]
 //                    [--look-at EX,EY,EZ,TX,TY,TZ] [--fov DEG] [--threads N]
 //                    [--stats] [--stats-json PATH] [--quiet]
 //
-// With no scene file (scene files arrive with the Python/scene issue) it renders the built-in
-// demo. Usage errors exit with status 2, failures with 1; every message names the bad input.
+// SCENE is a scene file (.obj, .gltf, .glb; see mipraster/io/scene_file.hpp); with none it
+// renders the built-in demo. Usage errors exit with status 2, failures with 1; every message names the bad input.
 #include <unistd.h>
 
 #include <cerrno>
@@ -21,6 +21,7 @@
 
 #include "mipraster/core/compare.hpp"
 #include "mipraster/io/image_io.hpp"
+#include "mipraster/io/scene_file.hpp"
 #include "mipraster/pipeline/renderer.hpp"
 #include "mipraster/scene/demo_scene.hpp"
 
@@ -30,11 +31,19 @@ using namespace mipraster;
 
 constexpr const char* kVersion = "0.1.0";
 
+// Scene files: the field of view of the framing camera (the demo's), and the clear colour, a
+// neutral mid grey (linear 0.18, sRGB ≈ 118) that shows both dark and light geometry.
+constexpr double kDefaultFovDegrees = 51.6;
+constexpr float kSceneFileClear = 0.18f;
+static_assert(kDefaultFovDegrees > 0.0 && kDefaultFovDegrees < 180.0, "a field of view in (0, 180)");
+static_assert(kSceneFileClear >= 0.0f && kSceneFileClear <= 1.0f, "a displayable grey");
+
 constexpr const char* kUsage =
     "usage: mipraster <command> [options]\n"
     "\n"
     "commands:\n"
-    "  render     render the built-in demo scene (a lit cube on a checkered plane)\n"
+    "  render     render a scene file (.obj, .gltf, .glb) or, without one, the built-in demo\n"
+    "             (a lit cube on a checkered plane): mipraster render [SCENE] -o OUT [options]\n"
     "  compare    compare two images value by value and print a report (idiff style)\n"
     "\n"
     "render options:\n"
@@ -44,8 +53,11 @@ constexpr const char* kUsage =
     "  --aa ssaa|msaa        shade every sample, or once per pixel per triangle [msaa]\n"
     "  --pattern NAME        auto, center, grid, rotated, stratified           [auto]\n"
     "  --seed N              seed of the stratified pattern                    [0]\n"
+    "  --camera N            use the scene file's N-th camera (0-based)\n"
     "  --look-at E,T         camera eye and target: EX,EY,EZ,TX,TY,TZ (+y up)   [the demo's]\n"
     "  --fov DEG             vertical field of view in degrees                  [51.6]\n"
+    "                        a scene file's camera: --camera N, else --look-at/--fov, else its\n"
+    "                        first camera, else one that frames the scene's bounding box\n"
     "  --threads N           worker threads, 0 = all cores                     [0]\n"
     "  --stats               print triangle, sample and per-stage time counts\n"
     "  --stats-json PATH     write the counts and times as JSON (- = stdout)\n"
@@ -106,6 +118,8 @@ std::vector<double> parse_numbers(const std::string& option, const std::string& 
 }
 
 struct RenderOptions {
+    std::string scene;  ///< scene file; empty: the built-in demo
+    int camera = -1;    ///< --camera N; −1: not given
     std::string output;
     RenderSettings settings;
     bool print_stats = false;
@@ -155,6 +169,9 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
             o.settings.pattern_seed = static_cast<std::uint64_t>(parse_int(a, value()));
         } else if (a == "--threads") {
             o.settings.threads = parse_int(a, value());
+        } else if (a == "--camera") {
+            o.camera = parse_int(a, value());
+            if (o.camera < 0) throw UsageError("--camera: expected a camera index >= 0, got " + args[i]);
         } else if (a == "--look-at") {
             o.look_at = parse_numbers(a, value(), 6);
         } else if (a == "--fov") {
@@ -167,10 +184,16 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
             o.stats_json = value();
         } else if (a == "--quiet") {
             o.quiet = true;
+        } else if (!a.empty() && a[0] != '-' && o.scene.empty()) {
+            o.scene = a;
+        } else if (!a.empty() && a[0] != '-') {
+            throw UsageError("render: more than one scene file ('" + o.scene + "', '" + a + "')");
         } else {
             throw UsageError("render: unknown option '" + a + "'");
         }
     }
+    if (o.camera >= 0 && o.scene.empty())
+        throw UsageError("--camera: needs a scene file (the built-in demo has one camera)");
     if (o.output.empty()) throw UsageError("render: missing -o PATH (where to write the image)");
     return o;
 }
@@ -180,18 +203,49 @@ int run_render(const std::vector<std::string>& args) {
     // Check the size before the scene is built from its aspect ratio.
     validate_framebuffer_size(o.settings.width, o.settings.height, o.settings.samples, true);
     const double aspect = static_cast<double>(o.settings.width) / o.settings.height;
-    const DemoScene scene = make_demo_scene(aspect);
-    Camera camera = scene.camera;
-    if (!o.look_at.empty() || o.fov_degrees > 0.0) {
-        const glm::dvec3 eye = o.look_at.empty() ? scene.eye : glm::dvec3(o.look_at[0], o.look_at[1], o.look_at[2]);
-        const glm::dvec3 target = o.look_at.empty() ? scene.target : glm::dvec3(o.look_at[3], o.look_at[4], o.look_at[5]);
-        const double fovy = o.fov_degrees > 0.0 ? o.fov_degrees * M_PI / 180.0 : scene.fovy;
-        camera = Camera::look_at_perspective(eye, target, {0, 1, 0}, fovy, aspect, scene.near);
-    }
     RenderSettings settings = o.settings;
-    settings.clear_color = scene.clear_color;
+    Camera camera;
+    std::vector<Draw> draws;
+    DemoScene demo;
+    LoadedScene loaded;
+    if (o.scene.empty()) {
+        demo = make_demo_scene(aspect);
+        camera = demo.camera;
+        if (!o.look_at.empty() || o.fov_degrees > 0.0) {
+            const glm::dvec3 eye = o.look_at.empty() ? demo.eye : glm::dvec3(o.look_at[0], o.look_at[1], o.look_at[2]);
+            const glm::dvec3 target = o.look_at.empty() ? demo.target : glm::dvec3(o.look_at[3], o.look_at[4], o.look_at[5]);
+            const double fovy = o.fov_degrees > 0.0 ? o.fov_degrees * M_PI / 180.0 : demo.fovy;
+            camera = Camera::look_at_perspective(eye, target, {0, 1, 0}, fovy, aspect, demo.near);
+        }
+        settings.clear_color = demo.clear_color;
+        draws = demo.draws;
+    } else {
+        loaded = load_scene(o.scene);  // std::runtime_error naming the file → exit status 1
+        if (!o.quiet)
+            for (const std::string& w : loaded.warnings) std::fprintf(stderr, "mipraster: warning: %s\n", w.c_str());
+        const double fovy = (o.fov_degrees > 0.0 ? o.fov_degrees : kDefaultFovDegrees) * M_PI / 180.0;
+        if (o.camera >= 0) {
+            if (static_cast<std::size_t>(o.camera) >= loaded.cameras.size())
+                throw std::invalid_argument("--camera " + std::to_string(o.camera) + ": " + o.scene + " has " +
+                                 std::to_string(loaded.cameras.size()) + " camera(s)" +
+                                 (loaded.cameras.empty() ? "" : " (0.." + std::to_string(loaded.cameras.size() - 1) + ")"));
+            camera = loaded.cameras[o.camera].build(aspect);
+        } else if (!o.look_at.empty()) {
+            const double near = 1e-3 * std::max(1.0, glm::length(glm::dvec3(o.look_at[3] - o.look_at[0],
+                                                                            o.look_at[4] - o.look_at[1],
+                                                                            o.look_at[5] - o.look_at[2])));
+            camera = Camera::look_at_perspective({o.look_at[0], o.look_at[1], o.look_at[2]},
+                                                 {o.look_at[3], o.look_at[4], o.look_at[5]}, {0, 1, 0}, fovy, aspect, near);
+        } else if (o.fov_degrees > 0.0 || loaded.cameras.empty()) {
+            camera = framing_camera(loaded.draws, fovy, aspect);
+        } else {
+            camera = loaded.cameras.front().build(aspect);
+        }
+        settings.clear_color = glm::vec4(kSceneFileClear, kSceneFileClear, kSceneFileClear, 1.0f);
+        draws = loaded.draws;
+    }
     if (!o.quiet && isatty(STDOUT_FILENO)) settings.progress = draw_progress;
-    const RenderResult result = render(scene.draws, camera, settings);
+    const RenderResult result = render(draws, camera, settings);
     write_image(o.output, result.color);
     if (!o.quiet)
         std::printf("wrote %s (%dx%d, %d spp %s, %.1f ms on %d threads)\n", o.output.c_str(), settings.width,

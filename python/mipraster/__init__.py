@@ -23,6 +23,7 @@ layer (:func:`rasterize`, :func:`interpolate`, :func:`resolve`: bring your own c
 positions) are Python over the C++ module ``mipraster._core``, which depends on nothing but the C++ standard library.
 Image files (:func:`read_image`, :func:`write_image`, :meth:`RenderResult.save`) use
 ``mipraster._image`` (OpenImageIO), imported on first use only, so ``import mipraster`` is fast.
+:func:`load_scene` reads OBJ and glTF scene files (geometry, colours, cameras) through the same module.
 
 :func:`compare` compares two images value by value with thresholds (OpenImageIO ``idiff`` style) and
 returns a :class:`CompareReport`; :mod:`mipraster.testing` (imported explicitly) builds golden-image
@@ -36,6 +37,7 @@ from .mesh import Mesh
 from .primitives import Raster, interpolate, rasterize, resolve
 from .render import RenderResult, render
 from .scene import Draw, Scene
+from .scene_file import load_scene
 
 __version__ = "0.1.0"
 
@@ -50,6 +52,7 @@ __all__ = [
     "compare",
     "linear_to_srgb",
     "linear_to_srgb8",
+    "load_scene",
     "interpolate",
     "rasterize",
     "read_image",

@@ -1,0 +1,73 @@
+"""Scene files: OBJ (+ MTL) and glTF 2.0 (.gltf, .glb) loaded into a :class:`Scene` and cameras.
+
+The files are read by ``mipraster._image`` (the module that holds the file formats, imported on
+first use); this module turns what it returns into :class:`Mesh`, :class:`Scene` and
+:class:`Camera` objects. What loads: triangle geometry, vertex colours (linear), material colours
+(OBJ ``Kd``, glTF ``baseColorFactor``, both linear), glTF node transforms, alpha blending
+(``alphaMode: BLEND``), back-face culling of single-sided glTF materials, and glTF cameras.
+Textures and texture coordinates are skipped until the texture issue.
+"""
+from __future__ import annotations
+
+import errno
+import math
+import os
+from typing import Any, List, Tuple
+
+from . import _core
+from .camera import Camera
+from .image import PathLike, _image_module, _path
+from .mesh import Mesh
+from .scene import Scene
+
+__all__ = ["load_scene"]
+
+
+def _camera_from_file(named: Any) -> Camera:
+    """A :class:`Camera` whose projection is built from the file's parameters for each image aspect."""
+    view = named.view
+
+    def build(width: int, height: int) -> _core.Camera:
+        return _core.Camera(view, named.projection_matrix(width / height), _core.DepthConvention.reverse_z)
+
+    if named.projection == "perspective":
+        params = dict(name=named.name, fov_y=math.degrees(named.yfov), aspect_ratio=named.aspect_ratio,
+                      near=named.znear, far=named.zfar)
+    else:
+        params = dict(name=named.name, xmag=named.xmag, ymag=named.ymag, near=named.znear, far=named.zfar)
+    return Camera(f"scene_file_{named.projection}", params, build, "reverse_z")
+
+
+def load_scene(path: PathLike) -> Tuple[Scene, List[Camera]]:
+    """Loads a scene file into ``(scene, cameras)``.
+
+    Args:
+        path: ``.obj`` (with the MTL files it names, looked up next to it), ``.gltf`` (with its
+            ``.bin`` buffers or data-URI buffers) or ``.glb``; the extension picks the reader.
+
+    Returns:
+        A :class:`Scene` with one draw per OBJ material or per glTF node primitive (model matrix =
+        the node's world matrix; colour = the material's linear base colour, premultiplied for
+        ``BLEND`` materials, which blend ``"over"``; single-sided glTF materials cull back faces),
+        and the file's cameras in node order as :class:`Camera` objects (OBJ has none). A
+        perspective camera uses the file's aspect ratio if it gives one, else the render's;
+        reverse-Z depth, infinite far plane when the file gives no ``zfar``. The scene's
+        ``clear_color`` is left None (transparent black). Textures are skipped.
+
+    Raises:
+        FileNotFoundError: there is no such file.
+        OSError: the file (or a buffer it names) cannot be read, or it is truncated or corrupt;
+            the message names the file and the problem, ``.filename`` is set.
+        ValueError: an unsupported extension (the message lists .obj, .gltf, .glb) or invalid
+            geometry (e.g. an index out of range, naming the file and the element).
+    """
+    p = _path(path)
+    if not os.path.exists(p):
+        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), p)
+    data = _image_module().load_scene(p)
+    meshes = [Mesh(positions, triangles, colors) for positions, triangles, colors in data["meshes"]]
+    scene = Scene()
+    for d in data["draws"]:
+        scene.add(meshes[d["mesh"]], model=d["model"], color=d["color"], blend=d["blend"], cull=d["cull"])
+    cameras = [_camera_from_file(c) for c in data["cameras"]]
+    return scene, cameras
