@@ -112,6 +112,16 @@ def _update_hint() -> str:
     return (f"run `{where}` (or pass update=True) to write it, look at the image, then commit it")
 
 
+def _holds(golden: pathlib.Path, actual8: np.ndarray) -> bool:
+    """Whether the golden file exists, is readable and holds exactly these sRGB8 bytes."""
+    if not golden.is_file():
+        return False
+    try:
+        return bool(np.array_equal(to_srgb8(read_image(golden)), actual8))
+    except OSError:
+        return False
+
+
 def assert_matches_golden(
     actual: Any,
     golden_path: PathLike,
@@ -172,15 +182,9 @@ def assert_matches_golden(
     actual_path, expected_path, diff_path = paths
 
     if update:
-        if golden.is_file():
-            try:
-                if np.array_equal(to_srgb8(read_image(golden)), actual8):
-                    _remove_stale(paths)
-                    return None
-            except OSError:
-                pass  # unreadable: overwrite it
-        golden.parent.mkdir(parents=True, exist_ok=True)
-        write_image(golden, a)
+        if not _holds(golden, actual8):  # rewrite only a changed, missing or unreadable golden
+            golden.parent.mkdir(parents=True, exist_ok=True)
+            write_image(golden, a)
         _remove_stale(paths)
         return None
 
