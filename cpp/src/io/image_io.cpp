@@ -1,8 +1,9 @@
 #include "mipraster/io/image_io.hpp"
 
+#include "file_extension.hpp"
+
 #include <OpenImageIO/imageio.h>
 
-#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -18,16 +19,6 @@ namespace mipraster {
 namespace {
 
 enum class FileKind { png, exr };
-
-std::string lower_extension(const std::string& path) {
-    const std::size_t slash = path.find_last_of("/\\");
-    const std::size_t dot = path.find_last_of('.');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-    std::string ext = path.substr(dot);
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-    return ext;
-}
 
 FileKind output_kind(const std::string& path) {
     const std::string ext = lower_extension(path);

@@ -2,6 +2,8 @@
 // includes either library.
 #include "mipraster/io/scene_file.hpp"
 
+#include "file_extension.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -30,15 +32,6 @@ namespace {
 constexpr std::size_t kMaxElements = std::numeric_limits<std::uint32_t>::max();
 constexpr int kMaxNodeDepth = 1024;
 static_assert(kMaxNodeDepth > 0 && kMaxElements > 0, "limits must be positive");
-
-std::string lower_extension(const std::string& path) {
-    const auto slash = path.find_last_of("/\\");
-    const auto dot = path.find_last_of('.');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-    std::string ext = path.substr(dot);
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext;
-}
 
 std::string directory_of(const std::string& path) {
     const auto slash = path.find_last_of('/');
