@@ -3,7 +3,8 @@
 //   mipraster compare A B [--fail T] [--fail-fraction F] [--hard-fail H]
 //   mipraster render [SCENE] -o OUT.png [--camera N] [--size WxH] [--spp N] [--aa ssaa|msaa] [--pattern NAME]
 //                    [--look-at EX,EY,EZ,TX,TY,TZ] [--fov DEG] [--threads N]
-//                    [--stats] [--stats-json PATH] [--quiet]
+//                    [--filter F] [--max-aniso N] [--wrap W[,W]] [--lod-bias B] [--debug-view V]
+//                    [--derivatives analytic|quad] [--stats] [--stats-json PATH] [--quiet]
 //
 // SCENE is a scene file (.obj, .gltf, .glb; see mipraster/io/scene_file.hpp); with none it
 // renders the built-in demo. Usage errors exit with status 2, failures with 1; every message names the bad input.
@@ -43,7 +44,8 @@ constexpr const char* kUsage =
     "\n"
     "commands:\n"
     "  render     render a scene file (.obj, .gltf, .glb) or, without one, the built-in demo\n"
-    "             (a lit cube on a checkered plane): mipraster render [SCENE] -o OUT [options]\n"
+    "             (a textured cube on a textured checker plane to the horizon):\n"
+    "             mipraster render [SCENE] -o OUT [options]\n"
     "  compare    compare two images value by value and print a report (idiff style)\n"
     "\n"
     "render options:\n"
@@ -59,6 +61,13 @@ constexpr const char* kUsage =
     "                        a scene file's camera: --camera N, else --look-at/--fov, else its\n"
     "                        first camera, else one that frames the scene's bounding box\n"
     "  --threads N           worker threads, 0 = all cores                     [0]\n"
+    "texture options (override every textured draw's sampler; default: the scene's own):\n"
+    "  --filter F            nearest, bilinear (no mip levels), trilinear, anisotropic, ewa, sat\n"
+    "  --max-aniso N         most probes (anisotropic) or largest axis ratio (ewa), >= 1\n"
+    "  --wrap W[,W]          repeat, clamp, mirror, border; one for both axes or u,v\n"
+    "  --lod-bias B          added to the level of detail (log2 texels per pixel)\n"
+    "  --debug-view V        none, mip-level (a colour per mip level), uv (uv as colour)\n"
+    "  --derivatives D       analytic (exact per sample) or quad (2x2 finite differences) [analytic]\n"
     "  --stats               print triangle, sample and per-stage time counts\n"
     "  --stats-json PATH     write the counts and times as JSON (- = stdout)\n"
     "  --quiet               print nothing but errors (no summary, no progress bar)\n"
@@ -127,7 +136,32 @@ struct RenderOptions {
     bool quiet = false;
     std::vector<double> look_at;  ///< empty: the demo's camera
     double fov_degrees = 0.0;     ///< 0: the demo's
+    // Sampler overrides for every textured draw; unset ones keep the scene's values.
+    std::string filter;
+    double max_aniso = 0.0, lod_bias = 0.0;
+    bool has_lod_bias = false;
+    std::vector<WrapMode> wrap;
 };
+
+// Applies the command line's sampler overrides to the textured draws.
+void override_samplers(const RenderOptions& o, std::vector<Draw>& draws) {
+    for (Draw& d : draws) {
+        if (!d.texture) continue;
+        if (!o.filter.empty()) {
+            const Sampler named = Sampler::from_filter_name(o.filter);
+            d.sampler.mag_filter = named.mag_filter;
+            d.sampler.min_filter = named.min_filter;
+            d.sampler.mip_filter = named.mip_filter;
+            d.sampler.footprint = named.footprint;
+        }
+        if (o.max_aniso > 0.0) d.sampler.max_anisotropy = static_cast<float>(o.max_aniso);
+        if (o.has_lod_bias) d.sampler.lod_bias = static_cast<float>(o.lod_bias);
+        if (!o.wrap.empty()) {
+            d.sampler.wrap_u = o.wrap.front();
+            d.sampler.wrap_v = o.wrap.back();
+        }
+    }
+}
 
 // A progress bar on stderr, redrawn as tiles finish.
 void draw_progress(std::size_t done, std::size_t total) {
@@ -178,6 +212,26 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
             o.fov_degrees = parse_number(a, value());
             if (!(o.fov_degrees > 0.0 && o.fov_degrees < 180.0))
                 throw UsageError("--fov: expected degrees in (0, 180), got " + args[i]);
+        } else if (a == "--filter") {
+            o.filter = value();
+            Sampler::from_filter_name(o.filter);  // checks the name
+        } else if (a == "--max-aniso") {
+            o.max_aniso = parse_number(a, value());
+            if (!(o.max_aniso >= 1.0 && o.max_aniso <= 1024.0))
+                throw UsageError("--max-aniso: expected a number in [1, 1024], got " + args[i]);
+        } else if (a == "--wrap") {
+            o.wrap.clear();
+            const std::string& v = value();
+            const auto comma = v.find(',');
+            o.wrap.push_back(parse_wrap_mode(v.substr(0, comma)));
+            if (comma != std::string::npos) o.wrap.push_back(parse_wrap_mode(v.substr(comma + 1)));
+        } else if (a == "--lod-bias") {
+            o.lod_bias = parse_number(a, value());
+            o.has_lod_bias = true;
+        } else if (a == "--debug-view") {
+            o.settings.debug_view = parse_debug_view(value());
+        } else if (a == "--derivatives") {
+            o.settings.derivatives = parse_derivative_mode(value());
         } else if (a == "--stats") {
             o.print_stats = true;
         } else if (a == "--stats-json") {
@@ -244,6 +298,7 @@ int run_render(const std::vector<std::string>& args) {
         settings.clear_color = glm::vec4(kSceneFileClear, kSceneFileClear, kSceneFileClear, 1.0f);
         draws = loaded.draws;
     }
+    override_samplers(o, draws);
     if (!o.quiet && isatty(STDOUT_FILENO)) settings.progress = draw_progress;
     const RenderResult result = render(draws, camera, settings);
     write_image(o.output, result.color);

@@ -36,7 +36,8 @@ std::string DrawState::to_string() const {
 }
 
 std::string Draw::to_string() const {
-    return "Draw(" + (mesh ? mesh->to_string() : std::string("no mesh")) + ", " + state.to_string() + ")";
+    return "Draw(" + (mesh ? mesh->to_string() : std::string("no mesh")) + ", " +
+           (texture ? texture.to_string() + ", " + sampler.to_string() + ", " : std::string()) + state.to_string() + ")";
 }
 
 }  // namespace mipraster

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <type_traits>
@@ -68,6 +69,12 @@ void validate_draws(const std::vector<Draw>& draws) {
         for (int c = 0; c < 4; ++c)
             if (!std::isfinite(draws[i].color[c]))
                 throw std::invalid_argument(name + ".color has a non-finite component");
+        if (draws[i].texture) {
+            if (!draws[i].mesh->has_uvs())
+                throw std::invalid_argument(name + " has a texture ('" + draws[i].texture.name() +
+                                            "') but its mesh has no uvs");
+            draws[i].sampler.validate();
+        }
     }
 }
 
@@ -84,6 +91,11 @@ PipelineKey pipeline_key(const Draw& draw, const Camera& camera, const RenderSet
     key.samples = settings.samples == 1 ? SampleMode::single
                   : settings.anti_aliasing == AntiAliasing::msaa ? SampleMode::msaa
                                                                  : SampleMode::ssaa;
+    // Derivatives only where λ matters: a sampler that ignores it, e.g. bilinear without mip
+    // levels, gets the kernel that computes none (debug views always need them).
+    if (draw.texture)
+        key.texturing = draw.sampler.needs_derivatives() || settings.debug_view != DebugView::none ? Texturing::lod
+                                                                                                   : Texturing::fixed;
     return key;
 }
 
@@ -291,11 +303,21 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     if (depth_output) result.depth = Image(settings.width, settings.height, 1);
     std::vector<TileKernel> kernels(draws.size());
     std::vector<DrawInputs> inputs(draws.size());
+    std::vector<std::unique_ptr<TextureView>> textures(draws.size());  // pinned for the render
     for (std::size_t d = 0; d < draws.size(); ++d) {
         kernels[d] = select_tile_kernel(pipeline_key(draws[d], camera, settings));
         const Mesh& mesh = *draws[d].mesh;
         inputs[d] = {mesh.triangles.data(), mesh.has_colors() ? mesh.colors.data() : nullptr, draws[d].color,
                      draws[d].state.depth_write};
+        if (draws[d].texture) {
+            textures[d] = std::make_unique<TextureView>(draws[d].texture);
+            inputs[d].uvs = mesh.uvs.data();
+            inputs[d].texture = textures[d].get();
+            inputs[d].sampler = &draws[d].sampler;
+            inputs[d].uv_interpolation = draws[d].state.interpolation;
+            inputs[d].derivatives = settings.derivatives;
+            inputs[d].debug_view = settings.debug_view;
+        }
     }
     std::vector<TileCounters> tile_counters(static_cast<std::size_t>(grid.count()));
     std::mutex progress_mutex;
@@ -422,7 +444,8 @@ std::string RenderSettings::to_string() const {
     return "RenderSettings(" + std::to_string(width) + "x" + std::to_string(height) + ", samples=" +
            std::to_string(samples) + ", pattern=" + mipraster::to_string(pattern) + ", aa=" +
            mipraster::to_string(anti_aliasing) + ", threads=" + std::to_string(threads) + ", resolve=" +
-           mipraster::to_string(resolve_filter) + ")";
+           mipraster::to_string(resolve_filter) + ", derivatives=" + mipraster::to_string(derivatives) +
+           ", debug_view=" + mipraster::to_string(debug_view) + ")";
 }
 
 std::string RenderStats::to_json() const {

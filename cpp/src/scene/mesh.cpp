@@ -10,20 +10,31 @@ const char* const kAxis[4] = {"x", "y", "z", "w"};
 const char* const kChannel[4] = {"r", "g", "b", "a"};
 }  // namespace
 
+namespace {
+
+// Throws unless `values` is empty or has one finite entry per vertex.
+template <typename Vec>
+void validate_per_vertex(const std::vector<Vec>& values, std::size_t vertex_count, const std::string& name,
+                         const char* const* component_names) {
+    if (!values.empty() && values.size() != vertex_count)
+        throw std::invalid_argument(name + " has " + std::to_string(values.size()) +
+                                    " entries; expected one per vertex (" + std::to_string(vertex_count) + ") or none");
+    for (std::size_t i = 0; i < values.size(); ++i)
+        for (int c = 0; c < Vec::length(); ++c)
+            if (!std::isfinite(values[i][c]))
+                throw std::invalid_argument(name + "[" + std::to_string(i) + "]." + component_names[c] + " is " +
+                                            std::to_string(values[i][c]) + "; expected a finite number");
+}
+
+const char* const kUv[2] = {"u", "v"};
+
+}  // namespace
+
 void Mesh::validate(const std::string& name) const {
-    for (std::size_t i = 0; i < positions.size(); ++i)
-        for (int c = 0; c < 3; ++c)
-            if (!std::isfinite(positions[i][c]))
-                throw std::invalid_argument(name + ".positions[" + std::to_string(i) + "]." + kAxis[c] +
-                                            " is " + std::to_string(positions[i][c]) + "; expected a finite number");
-    if (!colors.empty() && colors.size() != positions.size())
-        throw std::invalid_argument(name + ".colors has " + std::to_string(colors.size()) +
-                                    " entries; expected one per vertex (" + std::to_string(positions.size()) + ") or none");
-    for (std::size_t i = 0; i < colors.size(); ++i)
-        for (int c = 0; c < 4; ++c)
-            if (!std::isfinite(colors[i][c]))
-                throw std::invalid_argument(name + ".colors[" + std::to_string(i) + "]." + kChannel[c] +
-                                            " is " + std::to_string(colors[i][c]) + "; expected a finite number");
+    validate_per_vertex(positions, positions.size(), name + ".positions", kAxis);
+    validate_per_vertex(colors, positions.size(), name + ".colors", kChannel);
+    validate_per_vertex(uvs, positions.size(), name + ".uvs", kUv);
+    validate_per_vertex(normals, positions.size(), name + ".normals", kAxis);
     validate_triangle_indices(triangles, positions.size(), name + ".triangles");
 }
 
@@ -39,7 +50,7 @@ void validate_triangle_indices(const std::vector<glm::uvec3>& triangles, std::si
 
 std::string Mesh::to_string() const {
     return "Mesh(vertices=" + std::to_string(positions.size()) + ", triangles=" + std::to_string(triangles.size()) +
-           (has_colors() ? ", colors" : "") + ")";
+           (has_colors() ? ", colors" : "") + (has_uvs() ? ", uvs" : "") + (normals.empty() ? "" : ", normals") + ")";
 }
 
 }  // namespace mipraster

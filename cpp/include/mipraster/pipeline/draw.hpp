@@ -1,11 +1,14 @@
 #pragma once
-// A draw: a mesh, its model matrix, a constant colour and the fixed-function state it uses.
+// A draw: a mesh, its model matrix, its material (constant colour, optional base-colour texture and
+// sampler) and the fixed-function state it uses.
 #include <string>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec4.hpp>
 
 #include "mipraster/scene/mesh.hpp"
+#include "mipraster/texture/sampler.hpp"
+#include "mipraster/texture/texture.hpp"
 
 namespace mipraster {
 
@@ -42,11 +45,15 @@ struct DrawState {
 };
 
 /// One draw call. The fragment colour is `color` × the interpolated vertex colour (when the mesh
-/// has vertex colours), premultiplied linear RGBA. The mesh must outlive the render.
+/// has vertex colours) × the texture sampled at the interpolated uv (when `texture` is set; the
+/// mesh then needs uvs), all premultiplied linear RGBA. uvs interpolate like colours (the
+/// state's interpolation mode). The mesh must outlive the render.
 struct Draw {
     const Mesh* mesh = nullptr;
     glm::dmat4 model{1.0};
     glm::vec4 color{1.0f};
+    Texture texture;  ///< base colour; empty for an untextured draw
+    Sampler sampler;
     DrawState state;
 
     std::string to_string() const;

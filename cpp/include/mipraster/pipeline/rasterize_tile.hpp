@@ -10,7 +10,9 @@
 #include "mipraster/pipeline/draw.hpp"
 #include "mipraster/pipeline/framebuffer.hpp"
 #include "mipraster/pipeline/sample_pattern.hpp"
+#include "mipraster/pipeline/shade_texture.hpp"
 #include "mipraster/pipeline/triangle_setup.hpp"
+#include "mipraster/texture/texture.hpp"
 
 namespace mipraster {
 
@@ -21,12 +23,16 @@ enum class DepthFunc { none, greater, less };
 enum class Shading { constant, flat, screen, perspective, visibility };
 /// single: one sample per pixel; ssaa: shade every sample; msaa: shade once per pixel per triangle.
 enum class SampleMode { single, ssaa, msaa };
+/// What the texture needs: nothing (untextured: no uv, no derivatives), a lookup without
+/// derivatives (the sampler's result does not depend on λ), or a lookup with uv derivatives.
+enum class Texturing { none, fixed, lod };
 
 struct PipelineKey {
     DepthFunc depth = DepthFunc::none;
     BlendMode blend = BlendMode::replace;
     Shading shading = Shading::constant;
     SampleMode samples = SampleMode::single;
+    Texturing texturing = Texturing::none;
 };
 
 /// The pixel rectangle [x0, x1) × [y0, y1) of one tile and the sample storage it writes: RGBA
@@ -47,6 +53,13 @@ struct DrawInputs {
     const glm::vec4* vertex_colors;  ///< null when the mesh has none (then shading is constant)
     glm::vec4 color;
     bool depth_write;
+    // Texturing only:
+    const glm::vec2* uvs = nullptr;
+    const TextureView* texture = nullptr;
+    const Sampler* sampler = nullptr;
+    Interpolation uv_interpolation = Interpolation::perspective;
+    DerivativeMode derivatives = DerivativeMode::analytic;
+    DebugView debug_view = DebugView::none;
 };
 
 /// Triangles of one draw, in submission order: tris[indices[k]] for k < count.

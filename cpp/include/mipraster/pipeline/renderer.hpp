@@ -13,6 +13,7 @@
 #include "mipraster/pipeline/framebuffer.hpp"
 #include "mipraster/pipeline/resolve.hpp"
 #include "mipraster/pipeline/sample_pattern.hpp"
+#include "mipraster/pipeline/shade_texture.hpp"
 #include "mipraster/scene/camera.hpp"
 
 namespace mipraster {
@@ -35,6 +36,8 @@ struct RenderSettings {
     ResolveFilter resolve_filter = ResolveFilter::box;
     bool keep_samples = false;                      ///< return the supersample framebuffer too
     bool depth_output = false;                      ///< return RenderResult::depth (when some draw tests depth)
+    DerivativeMode derivatives = DerivativeMode::analytic;  ///< uv derivatives of textured draws
+    DebugView debug_view = DebugView::none;         ///< replaces the texture lookup of textured draws
     /// Called as tiles finish with (tiles done, tiles in all); calls are serialized (never
     /// concurrent) but may come from any worker thread. Empty: no progress reports.
     std::function<void(std::size_t, std::size_t)> progress;

@@ -1,6 +1,7 @@
 #pragma once
-// The built-in demo: a lit, vertex-coloured cube on a checkered ground plane that runs to the
-// horizon — thin far-away checks and the cube's silhouette show what antialiasing does.
+// The built-in demo: a lit, textured cube on a textured checker plane that runs to the horizon —
+// the far checks shrink below a pixel (mip-mapping and anisotropic filtering at work) and the
+// cube's silhouette shows what antialiasing does. Both textures are procedural (sRGB 8-bit).
 #include <memory>
 #include <vector>
 
