@@ -173,6 +173,14 @@ void bind_render(py::module_& m) {
         .def_readwrite("keep_samples", &RenderSettings::keep_samples, "return the supersample framebuffer too")
         .def_readwrite("depth_output", &RenderSettings::depth_output,
                        "return each pixel's view-space depth (nearest sample, +inf where empty)")
+        .def_property(
+            "derivatives", [](const RenderSettings& s) { return to_string(s.derivatives); },
+            [](RenderSettings& s, const std::string& name) { s.derivatives = parse_derivative_mode(name); },
+            "uv derivatives of textured draws: 'analytic' or 'quad'")
+        .def_property(
+            "debug_view", [](const RenderSettings& s) { return to_string(s.debug_view); },
+            [](RenderSettings& s, const std::string& name) { s.debug_view = parse_debug_view(name); },
+            "'none', 'mip-level' or 'uv': replaces the texture lookup of textured draws")
         .def("__repr__", &RenderSettings::to_string);
 
     py::class_<RasterizeSettings>(m, "RasterizeSettings", "Image size, sampling, depth convention and culling of rasterize().")

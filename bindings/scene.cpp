@@ -28,6 +28,7 @@ namespace {
 static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be 3 packed floats");
 static_assert(sizeof(glm::uvec3) == 3 * sizeof(std::uint32_t), "glm::uvec3 must be 3 packed uint32");
 static_assert(sizeof(glm::vec4) == 4 * sizeof(float), "glm::vec4 must be 4 packed floats");
+static_assert(sizeof(glm::vec2) == 2 * sizeof(float), "glm::vec2 must be 2 packed floats");
 
 // Copies an (N, C) array into a vector of GLM vectors of C components.
 template <class Vec, class T>
@@ -48,25 +49,39 @@ py::object view_rows(const std::vector<Vec>& rows, py::ssize_t columns, py::hand
     return std::move(a);
 }
 
+// Copies an optional per-vertex array, checking it has one row per vertex.
+template <class Vec>
+std::vector<Vec> copy_per_vertex(const std::optional<CArray<float>>& a, py::ssize_t columns, const char* name,
+                                 std::size_t vertex_count) {
+    if (!a) return {};
+    std::vector<Vec> rows = copy_rows<Vec>(*a, columns, name);
+    if (rows.size() != vertex_count)
+        throw py::value_error(std::string(name) + ": expected one row per vertex (" + std::to_string(vertex_count) +
+                              "), got " + std::to_string(rows.size()));
+    return rows;
+}
+
 std::shared_ptr<Mesh> make_mesh(const CArray<float>& positions, const CArray<std::uint32_t>& triangles,
-                                const std::optional<CArray<float>>& colors) {
+                                const std::optional<CArray<float>>& colors, const std::optional<CArray<float>>& uvs,
+                                const std::optional<CArray<float>>& normals) {
     auto mesh = std::make_shared<Mesh>();
     mesh->positions = copy_rows<glm::vec3>(positions, 3, "positions");
     mesh->triangles = copy_rows<glm::uvec3>(triangles, 3, "triangles");
-    if (colors) {
-        mesh->colors = copy_rows<glm::vec4>(*colors, 4, "colors");
-        if (mesh->colors.size() != mesh->positions.size())
-            throw py::value_error("colors: expected one row per vertex (" + std::to_string(mesh->positions.size()) +
-                                  "), got " + std::to_string(mesh->colors.size()));
-    }
+    mesh->colors = copy_per_vertex<glm::vec4>(colors, 4, "colors", mesh->positions.size());
+    mesh->uvs = copy_per_vertex<glm::vec2>(uvs, 2, "uvs", mesh->positions.size());
+    mesh->normals = copy_per_vertex<glm::vec3>(normals, 3, "normals", mesh->positions.size());
     mesh->validate("mesh");
     return mesh;
 }
 
 PyDraw make_draw(std::shared_ptr<Mesh> mesh, const std::optional<CArray<double>>& model,
                  const CArray<float>& color, bool depth_test, bool depth_write, BlendMode blend,
-                 Interpolation interpolation, CullMode cull) {
+                 Interpolation interpolation, CullMode cull, const std::optional<Texture>& texture,
+                 const std::optional<Sampler>& sampler) {
     if (!mesh) throw py::value_error("Draw: mesh is None");
+    if (texture && *texture && !mesh->has_uvs())
+        throw py::value_error("texture: the mesh has no uvs (give Mesh(..., uvs=...) to texture it)");
+    if (sampler) sampler->validate();
     PyDraw d;
     d.draw.mesh = mesh.get();
     d.draw.model = model ? to_dmat4(*model, "model") : glm::dmat4(1.0);
@@ -81,6 +96,8 @@ PyDraw make_draw(std::shared_ptr<Mesh> mesh, const std::optional<CArray<double>>
     d.draw.state.blend = blend;
     d.draw.state.interpolation = interpolation;
     d.draw.state.cull = cull;
+    if (texture) d.draw.texture = *texture;
+    if (sampler) d.draw.sampler = *sampler;
     d.mesh = std::move(mesh);
     return d;
 }
@@ -198,8 +215,10 @@ void bind_scene(py::module_& m) {
     py::class_<Mesh, std::shared_ptr<Mesh>>(
         m, "Mesh",
         "Indexed triangles: positions (N, 3) float32, triangles (T, 3) uint32 and optional colors (N, 4)\n"
-        "float32 (linear, premultiplied RGBA). The arrays are copied in once and read back as read-only views.")
-        .def(py::init(&make_mesh), py::arg("positions"), py::arg("triangles"), py::arg("colors") = py::none())
+        "float32 (linear, premultiplied RGBA), uvs (N, 2) float32 and normals (N, 3) float32. The arrays\n"
+        "are copied in once and read back as read-only views.")
+        .def(py::init(&make_mesh), py::arg("positions"), py::arg("triangles"), py::arg("colors") = py::none(),
+             py::arg("uvs") = py::none(), py::arg("normals") = py::none())
         .def_property_readonly(
             "positions", [](py::object self) { return view_rows<float>(self.cast<const Mesh&>().positions, 3, self); })
         .def_property_readonly("triangles",
@@ -212,9 +231,22 @@ void bind_scene(py::module_& m) {
                                    if (!mesh.has_colors()) return py::none();
                                    return view_rows<float>(mesh.colors, 4, self);
                                })
+        .def_property_readonly("uvs",
+                               [](py::object self) -> py::object {
+                                   const Mesh& mesh = self.cast<const Mesh&>();
+                                   if (!mesh.has_uvs()) return py::none();
+                                   return view_rows<float>(mesh.uvs, 2, self);
+                               })
+        .def_property_readonly("normals",
+                               [](py::object self) -> py::object {
+                                   const Mesh& mesh = self.cast<const Mesh&>();
+                                   if (mesh.normals.empty()) return py::none();
+                                   return view_rows<float>(mesh.normals, 3, self);
+                               })
         .def_property_readonly("vertex_count", [](const Mesh& mesh) { return mesh.positions.size(); })
         .def_property_readonly("triangle_count", [](const Mesh& mesh) { return mesh.triangles.size(); })
         .def("has_colors", &Mesh::has_colors)
+        .def("has_uvs", &Mesh::has_uvs)
         .def("validate", &Mesh::validate, py::arg("name") = "mesh",
              "Raises ValueError naming the first non-finite value or out-of-range index.")
         .def("__repr__", &Mesh::to_string);
@@ -222,11 +254,13 @@ void bind_scene(py::module_& m) {
     // --- Draw -------------------------------------------------------------------------------------
     py::class_<PyDraw>(m, "Draw",
                        "One draw call: a mesh, its model matrix, a constant colour (premultiplied linear RGBA,\n"
-                       "multiplied with the vertex colours) and the fixed-function state.")
+                       "multiplied with the vertex colours), an optional base-colour texture with its sampler\n"
+                       "(multiplied in too) and the fixed-function state.")
         .def(py::init(&make_draw), py::arg("mesh"), py::arg("model") = py::none(),
              py::arg("color") = std::vector<float>{1.0f, 1.0f, 1.0f, 1.0f}, py::arg("depth_test") = true,
              py::arg("depth_write") = true, py::arg("blend") = BlendMode::replace,
-             py::arg("interpolation") = Interpolation::perspective, py::arg("cull") = CullMode::none)
+             py::arg("interpolation") = Interpolation::perspective, py::arg("cull") = CullMode::none,
+             py::arg("texture") = py::none(), py::arg("sampler") = py::none())
         .def_property_readonly("mesh", [](const PyDraw& d) { return d.mesh; })
         .def_property_readonly("model", [](const PyDraw& d) { return from_dmat4(d.draw.model); })
         .def_property_readonly("color", [](const PyDraw& d) { return from_vec4(d.draw.color); })
@@ -235,10 +269,16 @@ void bind_scene(py::module_& m) {
         .def_property_readonly("blend", [](const PyDraw& d) { return d.draw.state.blend; })
         .def_property_readonly("interpolation", [](const PyDraw& d) { return d.draw.state.interpolation; })
         .def_property_readonly("cull", [](const PyDraw& d) { return d.draw.state.cull; })
+        .def_property_readonly("texture",
+                               [](const PyDraw& d) -> std::optional<Texture> {
+                                   if (!d.draw.texture) return std::nullopt;
+                                   return d.draw.texture;
+                               })
+        .def_property_readonly("sampler", [](const PyDraw& d) { return d.draw.sampler; })
         .def("__repr__", [](const PyDraw& d) { return d.draw.to_string(); });
 
     // --- the built-in demo ------------------------------------------------------------------------
-    py::class_<PyDemoScene>(m, "DemoScene", "The built-in demo: a lit cube on a checkered plane.")
+    py::class_<PyDemoScene>(m, "DemoScene", "The built-in demo: a lit, textured cube on a textured checker plane.")
         .def_readonly("meshes", &PyDemoScene::meshes)
         .def_readonly("draws", &PyDemoScene::draws)
         .def_readonly("camera", &PyDemoScene::camera)

@@ -14,16 +14,25 @@ Build a scene from numpy arrays, pick a camera and render::
     result.color          # (360, 640, 4) float32, linear premultiplied RGBA
     result.save("triangle.png")                                    # sRGB 8-bit
 
+Textures: give the mesh uvs and the draw a :class:`Texture` and a :class:`Sampler`::
+
+    quad = mr.Mesh([[-1, 0, 0], [1, 0, 0], [1, 2, 0], [-1, 2, 0]], [[0, 1, 2], [0, 2, 3]],
+                   uvs=[[0, 1], [1, 1], [1, 0], [0, 0]])           # (0, 0) = top-left texel
+    checker = (np.indices((64, 64)).sum(0) // 8 % 2 * 255).astype(np.uint8)   # sRGB8 grey
+    scene.add(quad, texture=mr.Texture(checker), sampler=mr.Sampler("anisotropic"))
+
 Conventions: right-handed world, the camera looks down −z with +y up; arrays are (H, W, C) with
 row 0 at the top; pixel (i, j) covers [i, i+1) × [j, j+1), its centre is (i + ½, j + ½); colour
 is linear premultiplied RGBA; the library's cameras use reverse-Z depth.
 
-The scene layer (:class:`Mesh`, :class:`Camera`, :class:`Scene`, :func:`render`) and the primitive
+The scene layer (:class:`Mesh`, :class:`Camera`, :class:`Texture`, :class:`Sampler`,
+:class:`Material`, :class:`Scene`, :func:`render`) and the primitive
 layer (:func:`rasterize`, :func:`interpolate`, :func:`resolve`: bring your own clip-space
 positions) are Python over the C++ module ``mipraster._core``, which depends on nothing but the C++ standard library.
 Image files (:func:`read_image`, :func:`write_image`, :meth:`RenderResult.save`) use
 ``mipraster._image`` (OpenImageIO), imported on first use only, so ``import mipraster`` is fast.
-:func:`load_scene` reads OBJ and glTF scene files (geometry, colours, cameras) through the same module.
+:func:`load_scene` reads OBJ and glTF scene files (geometry, colours, uvs, normals, base-colour
+textures with their samplers, cameras) through the same module.
 
 :func:`compare` compares two images value by value with thresholds (OpenImageIO ``idiff`` style) and
 returns a :class:`CompareReport`; :mod:`mipraster.testing` (imported explicitly) builds golden-image
@@ -36,8 +45,9 @@ from .image import read_image, to_srgb8, write_image
 from .mesh import Mesh
 from .primitives import Raster, interpolate, rasterize, resolve
 from .render import RenderResult, render
-from .scene import Draw, Scene
+from .scene import Draw, Material, Scene
 from .scene_file import load_scene
+from .texture import Sampler, Texture, clear_texture_cache, set_texture_cache_budget, texture_cache_stats
 
 __version__ = "0.1.0"
 
@@ -45,10 +55,14 @@ __all__ = [
     "Camera",
     "CompareReport",
     "Draw",
+    "Material",
     "Mesh",
     "Raster",
     "RenderResult",
+    "Sampler",
     "Scene",
+    "Texture",
+    "clear_texture_cache",
     "compare",
     "linear_to_srgb",
     "linear_to_srgb8",
@@ -58,7 +72,9 @@ __all__ = [
     "read_image",
     "render",
     "resolve",
+    "set_texture_cache_budget",
     "srgb_to_linear",
+    "texture_cache_stats",
     "to_srgb8",
     "write_image",
 ]

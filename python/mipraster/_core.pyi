@@ -91,7 +91,12 @@ class Camera:
 
 class Mesh:
     def __init__(
-        self, positions: _ArrayLike, triangles: _ArrayLike, colors: Optional[_ArrayLike] = None
+        self,
+        positions: _ArrayLike,
+        triangles: _ArrayLike,
+        colors: Optional[_ArrayLike] = None,
+        uvs: Optional[_ArrayLike] = None,
+        normals: Optional[_ArrayLike] = None,
     ) -> None: ...
     @property
     def positions(self) -> _Float32Array: ...
@@ -100,10 +105,15 @@ class Mesh:
     @property
     def colors(self) -> Optional[_Float32Array]: ...
     @property
+    def uvs(self) -> Optional[_Float32Array]: ...
+    @property
+    def normals(self) -> Optional[_Float32Array]: ...
+    @property
     def vertex_count(self) -> int: ...
     @property
     def triangle_count(self) -> int: ...
     def has_colors(self) -> bool: ...
+    def has_uvs(self) -> bool: ...
     def validate(self, name: str = "mesh") -> None: ...
 
 class Draw:
@@ -117,6 +127,8 @@ class Draw:
         blend: BlendMode = ...,
         interpolation: Interpolation = ...,
         cull: CullMode = ...,
+        texture: Optional[Texture] = None,
+        sampler: Optional[Sampler] = None,
     ) -> None: ...
     @property
     def mesh(self) -> Mesh: ...
@@ -134,6 +146,10 @@ class Draw:
     def interpolation(self) -> Interpolation: ...
     @property
     def cull(self) -> CullMode: ...
+    @property
+    def texture(self) -> Optional[Texture]: ...
+    @property
+    def sampler(self) -> Sampler: ...
 
 class DemoScene:
     @property
@@ -162,6 +178,8 @@ class RenderSettings:
     threads: int
     keep_samples: bool
     depth_output: bool
+    derivatives: str
+    debug_view: str
     def __init__(self) -> None: ...
     @property
     def clear_color(self) -> _RGBA: ...
@@ -249,3 +267,86 @@ class CompareReport:
         """Raises TypeError: use ``passed``."""
 
 def compare_images(actual: _ArrayLike, expected: _ArrayLike, settings: CompareSettings = ...) -> CompareReport: ...
+
+# --- textures ----------------------------------------------------------------------------------
+
+MAX_TEXTURE_DIMENSION: int
+MAX_TEXTURE_BYTES: int
+
+class WrapMode(_Enum):
+    repeat: ClassVar[WrapMode]
+    clamp: ClassVar[WrapMode]
+    mirror: ClassVar[WrapMode]
+    border: ClassVar[WrapMode]
+
+class TexelFilter(_Enum):
+    nearest: ClassVar[TexelFilter]
+    linear: ClassVar[TexelFilter]
+
+class MipFilter(_Enum):
+    none: ClassVar[MipFilter]
+    nearest: ClassVar[MipFilter]
+    linear: ClassVar[MipFilter]
+
+class FootprintFilter(_Enum):
+    isotropic: ClassVar[FootprintFilter]
+    anisotropic: ClassVar[FootprintFilter]
+    ewa: ClassVar[FootprintFilter]
+    sat: ClassVar[FootprintFilter]
+
+class Sampler:
+    mag_filter: TexelFilter
+    min_filter: TexelFilter
+    mip_filter: MipFilter
+    footprint: FootprintFilter
+    max_anisotropy: float
+    wrap_u: WrapMode
+    wrap_v: WrapMode
+    lod_bias: float
+    min_lod: float
+    max_lod: float
+    def __init__(self) -> None: ...
+    @staticmethod
+    def from_filter_name(name: str) -> Sampler: ...
+    @property
+    def border_color(self) -> _RGBA: ...
+    @border_color.setter
+    def border_color(self, value: _ArrayLike) -> None: ...
+    def needs_derivatives(self) -> bool: ...
+    def uses_mip_levels(self) -> bool: ...
+    def validate(self) -> None: ...
+
+class Texture:
+    @staticmethod
+    def from_uint8(texels: npt.NDArray[np.uint8], srgb: bool = True, name: str = "texture") -> Texture: ...
+    @staticmethod
+    def from_uint16(texels: npt.NDArray[np.uint16], srgb: bool = True, name: str = "texture") -> Texture: ...
+    @staticmethod
+    def from_float(texels: _ArrayLike, premultiplied: bool = False, name: str = "texture") -> Texture: ...
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    @property
+    def level_count(self) -> int: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def built_levels(self) -> int: ...
+    @property
+    def has_summed_area_table(self) -> bool: ...
+    @property
+    def derived_bytes(self) -> int: ...
+    @property
+    def identity(self) -> int: ...
+    def level(self, k: int) -> _Float32Array: ...
+
+def sample_texture(
+    texture: Texture, sampler: Sampler, uv: _ArrayLike, duv_dx: _ArrayLike, duv_dy: _ArrayLike
+) -> _Float32Array:
+    """uv (N, 2) float32, duv_dx / duv_dy (N, 2) or (1, 2) -> (N, 4) float32 premultiplied linear RGBA."""
+def texture_lod(texture: Texture, sampler: Sampler, duv_dx: _ArrayLike, duv_dy: _ArrayLike) -> _Float64Array: ...
+def texture_cache_stats() -> Dict[str, int]:
+    """Keys: budget_bytes, derived_bytes, levels_built, tables_built, evictions, keyed_textures."""
+def set_texture_cache_budget(budget_bytes: int) -> None: ...
+def clear_texture_cache() -> None: ...

@@ -11,7 +11,8 @@ __all__ = ["Mesh"]
 
 
 class Mesh:
-    """Indexed triangles: vertex positions, triangle indices and optional vertex colours.
+    """Indexed triangles: vertex positions, triangle indices and optional per-vertex colours,
+    texture coordinates and normals.
 
     Args:
         positions: ``(N, 3)`` vertex positions, any float or integer dtype (stored as float32).
@@ -21,10 +22,14 @@ class Mesh:
             (alpha 1 when 3 channels are given), stored as float32. Integer arrays (e.g. a list
             like ``[[1, 0, 0], ...]``) are accepted when every value is 0 or 1; 8-bit sRGB codes
             are refused (convert them with ``mipraster.srgb_to_linear(rgb8 / 255)``).
+        uvs: optional ``(N, 2)`` texture coordinates, any real dtype (stored as float32); (0, 0) is
+            the top-left corner of the texture image, v grows downwards (glTF convention).
+        normals: optional ``(N, 3)`` vertex normals (stored as float32; carried, not yet used
+            for shading).
 
     Lists, non-contiguous and Fortran-order arrays are accepted; the data are checked, converted
-    and copied once into the C++ mesh. ``positions``, ``triangles`` and ``colors`` read back as
-    read-only views of that copy.
+    and copied once into the C++ mesh. The arrays read back as read-only views of
+    that copy.
 
     Raises:
         TypeError: an array of bool, complex, string or object dtype, or float triangles.
@@ -35,7 +40,8 @@ class Mesh:
 
     __slots__ = ("_mesh",)
 
-    def __init__(self, positions: Any, triangles: Any, colors: Optional[Any] = None) -> None:
+    def __init__(self, positions: Any, triangles: Any, colors: Optional[Any] = None, uvs: Optional[Any] = None,
+                 normals: Optional[Any] = None) -> None:
         pos = _checks.empty_rows(_checks.real_array(positions, "positions"), 3)
         _checks.check_shape(pos, "positions", (None, 3))
         _checks.check_finite(pos, "positions")
@@ -60,7 +66,9 @@ class Mesh:
                 col = np.concatenate([col, np.ones((n, 1), dtype=col.dtype)], axis=1)
             col32 = _checks.to_float32(col, "colors")
 
-        self._mesh = _core.Mesh(pos32, tri32, col32)
+        uv32 = None if uvs is None else _per_vertex(uvs, "uvs", n, 2)
+        nrm32 = None if normals is None else _per_vertex(normals, "normals", n, 3)
+        self._mesh = _core.Mesh(pos32, tri32, col32, uv32, nrm32)
 
     @classmethod
     def _from_core(cls, mesh: _core.Mesh) -> "Mesh":
@@ -85,6 +93,16 @@ class Mesh:
         return self._mesh.colors
 
     @property
+    def uvs(self) -> Optional[np.ndarray]:
+        """``(N, 2)`` float32 texture coordinates (read-only view), or None."""
+        return self._mesh.uvs
+
+    @property
+    def normals(self) -> Optional[np.ndarray]:
+        """``(N, 3)`` float32 vertex normals (read-only view), or None."""
+        return self._mesh.normals
+
+    @property
     def vertex_count(self) -> int:
         """Number of vertices N."""
         return self._mesh.vertex_count
@@ -95,8 +113,16 @@ class Mesh:
         return self._mesh.triangle_count
 
     def __repr__(self) -> str:
-        colors = ", colors=RGBA" if self._mesh.has_colors() else ""
-        return f"Mesh(vertices={self.vertex_count}, triangles={self.triangle_count}{colors})"
+        extras = "".join(f", {name}" for name in ("colors", "uvs", "normals") if getattr(self._mesh, name) is not None)
+        return f"Mesh(vertices={self.vertex_count}, triangles={self.triangle_count}{extras})"
+
+
+def _per_vertex(values: Any, name: str, n: int, columns: int) -> np.ndarray:
+    """A checked ``(n, columns)`` float32 copy of an optional per-vertex array."""
+    a = _checks.empty_rows(_checks.real_array(values, name), columns)
+    _checks.check_shape(a, name, (n, columns))
+    _checks.check_finite(a, name)
+    return _checks.to_float32(a, name)
 
 
 def _check_indices(tri: np.ndarray, n: int) -> None:

@@ -13,6 +13,8 @@ from .scene import Scene, _core_draws
 __all__ = ["render", "RenderResult"]
 
 ANTI_ALIASING = {"ssaa": _core.AntiAliasing.ssaa, "msaa": _core.AntiAliasing.msaa}
+DERIVATIVES = {"analytic": "analytic", "quad": "quad"}
+DEBUG_VIEWS = {"none": "none", "mip-level": "mip-level", "uv": "uv"}
 PATTERNS = {
     "auto": _core.PatternKind.automatic,
     "center": _core.PatternKind.center,
@@ -102,7 +104,8 @@ def _int_in(value: Any, name: str, lo: int, hi: int, expected: str) -> int:
 
 def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, aa: str = "ssaa",
            pattern: str = "auto", seed: int = 0, threads: int = 0, clear_color: Any = None,
-           keep_samples: bool = False, depth: bool = True) -> RenderResult:
+           keep_samples: bool = False, depth: bool = True, derivatives: str = "analytic",
+           debug_view: str = "none") -> RenderResult:
     """Renders ``scene`` through ``camera`` into a ``width`` × ``height`` image.
 
     Args:
@@ -120,6 +123,11 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
         keep_samples: also return every sample (and its depth) in ``samples`` / ``sample_depth``.
         depth: return each pixel's view-space depth in ``depth`` (cheap; needs a projection whose
             z and w rows depend on view-space z only, as every perspective and orthographic one does).
+        derivatives: uv derivatives of textured draws: ``"analytic"`` (the chain rule from the
+            triangle's planes, exact per sample) or ``"quad"`` (differences across the 2×2 pixel
+            quad, as GPUs do).
+        debug_view: ``"none"``, ``"mip-level"`` (textured draws show a colour per mip level,
+            blended for fractional levels) or ``"uv"`` (textured draws show fract(u), fract(v)).
 
     Returns:
         A :class:`RenderResult`.
@@ -144,6 +152,8 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     pattern_kind = _checks.choice(pattern, "pattern", PATTERNS)
     keep = _checks.flag(keep_samples, "keep_samples")
     depth_output = _checks.flag(depth, "depth")
+    derivative_mode = _checks.choice(derivatives, "derivatives", DERIVATIVES)
+    debug = _checks.choice(debug_view, "debug_view", DEBUG_VIEWS)
     if clear_color is None:
         clear_color = scene.clear_color if scene.clear_color is not None else (0.0, 0.0, 0.0, 0.0)
     clear = _checks.rgba(clear_color, "clear_color")
@@ -158,4 +168,5 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     settings.anti_aliasing, settings.pattern, settings.pattern_seed = anti_aliasing, pattern_kind, pattern_seed
     settings.threads, settings.clear_color, settings.keep_samples = n_threads, clear, keep
     settings.depth_output = depth_output
+    settings.derivatives, settings.debug_view = derivative_mode, debug
     return RenderResult(_core.render(draws, core_camera, settings))

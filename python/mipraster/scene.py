@@ -1,13 +1,15 @@
-"""Scenes: an ordered list of draws (a mesh, a model matrix, a colour and fixed-function state)."""
+"""Scenes: an ordered list of draws (a mesh, a model matrix, a material and fixed-function state)."""
 from __future__ import annotations
 
-from typing import Any, Iterator, List, Optional, Tuple
+from dataclasses import dataclass
+from typing import Any, Iterator, List, Optional, Tuple, Union
 
 from . import _checks, _core
 from .camera import Camera
 from .mesh import Mesh
+from .texture import Sampler, Texture, _sampler
 
-__all__ = ["Draw", "Scene"]
+__all__ = ["Draw", "Material", "Scene"]
 
 BLEND_MODES = {"replace": _core.BlendMode.replace, "add": _core.BlendMode.add, "over": _core.BlendMode.over}
 INTERPOLATIONS = {
@@ -16,6 +18,22 @@ INTERPOLATIONS = {
     "flat": _core.Interpolation.flat,
 }
 CULL_MODES = {"none": _core.CullMode.none, "back": _core.CullMode.back, "front": _core.CullMode.front}
+
+
+@dataclass(frozen=True)
+class Material:
+    """What a surface looks like: fragment colour = ``color`` × vertex colour × ``texture``.
+
+    Attributes:
+        color: constant linear premultiplied RGBA (3 components: alpha 1).
+        texture: optional base-colour :class:`Texture` (the mesh needs uvs).
+        sampler: how the texture is filtered and wrapped: a :class:`Sampler`, a filter name
+            (``"trilinear"``, ``"anisotropic"``, ...) or None for the default (trilinear, repeat).
+    """
+
+    color: Any = (1.0, 1.0, 1.0, 1.0)
+    texture: Optional[Texture] = None
+    sampler: Union[Sampler, str, None] = None
 
 
 class Draw:
@@ -29,6 +47,8 @@ class Draw:
         blend: ``"replace"``, ``"add"`` or ``"over"`` (premultiplied Porter–Duff over).
         interpolation: ``"perspective"``, ``"screen"`` (affine) or ``"flat"`` (first vertex).
         cull: ``"none"``, ``"back"`` or ``"front"`` (front faces are counter-clockwise on screen).
+        texture: the base-colour :class:`Texture`, or None.
+        sampler: the :class:`Sampler` of the texture.
     """
 
     __slots__ = ("_mesh", "_draw")
@@ -45,6 +65,17 @@ class Draw:
     blend = property(lambda self: self._draw.blend.name, doc="'replace', 'add' or 'over'.")
     interpolation = property(lambda self: self._draw.interpolation.name, doc="'perspective', 'screen' or 'flat'.")
     cull = property(lambda self: self._draw.cull.name, doc="'none', 'back' or 'front'.")
+
+    @property
+    def texture(self) -> Optional[Texture]:
+        """The base-colour texture, or None."""
+        t = self._draw.texture
+        return None if t is None else Texture._from_core(t)
+
+    @property
+    def sampler(self) -> Sampler:
+        """The texture's sampler."""
+        return Sampler._from_core(self._draw.sampler)
 
     def __repr__(self) -> str:
         return (f"Draw({self._mesh!r}, color={self.color}, depth_test={self.depth_test}, "
@@ -67,13 +98,19 @@ class Scene:
 
     def add(self, mesh: Mesh, model: Any = None, color: Any = (1.0, 1.0, 1.0, 1.0), depth_test: bool = True,
             depth_write: bool = True, blend: str = "replace", interpolation: str = "perspective",
-            cull: str = "none") -> Draw:
+            cull: str = "none", texture: Optional[Texture] = None, sampler: Union[Sampler, str, None] = None,
+            material: Optional[Material] = None) -> Draw:
         """Appends a draw of ``mesh`` and returns it.
 
         Args:
             mesh: a :class:`Mesh`.
             model: 4×4 model matrix (object → world, column vectors), default identity.
             color: 3 (alpha 1) or 4 components, linear premultiplied; multiplies the vertex colours.
+            texture: a base-colour :class:`Texture` multiplied in (the mesh needs uvs); uvs are
+                interpolated like colours (``interpolation``).
+            sampler: the texture's :class:`Sampler` or a filter name; default trilinear, repeat.
+            material: a :class:`Material` giving color, texture and sampler at once (then those
+                three arguments must be left at their defaults).
             depth_test: test samples against the depth buffer (the camera's depth convention decides
                 GREATER or LESS).
             depth_write: store the depth of samples that pass.
@@ -88,6 +125,17 @@ class Scene:
         """
         if not isinstance(mesh, Mesh):
             raise TypeError(f"mesh: expected a mipraster.Mesh, got {type(mesh).__name__}")
+        if material is not None:
+            if not isinstance(material, Material):
+                raise TypeError(f"material: expected a mipraster.Material, got {type(material).__name__}")
+            if texture is not None or sampler is not None or tuple(color) != (1.0, 1.0, 1.0, 1.0):
+                raise ValueError("material: give either material or color/texture/sampler, not both")
+            color, texture, sampler = material.color, material.texture, material.sampler
+        if texture is not None and not isinstance(texture, Texture):
+            raise TypeError(f"texture: expected a mipraster.Texture, got {type(texture).__name__}")
+        if texture is not None and mesh.uvs is None:
+            raise ValueError("texture: the mesh has no uvs; give Mesh(..., uvs=...) to texture it")
+        core_sampler = _sampler(sampler)._sampler
         m = None if model is None else _checks.matrix(model, "model", 4, 4)
         draw = _core.Draw(
             mesh._mesh,
@@ -98,6 +146,8 @@ class Scene:
             blend=_checks.choice(blend, "blend", BLEND_MODES),
             interpolation=_checks.choice(interpolation, "interpolation", INTERPOLATIONS),
             cull=_checks.choice(cull, "cull", CULL_MODES),
+            texture=None if texture is None else texture._texture,
+            sampler=core_sampler,
         )
         item = Draw(mesh, draw)
         self.draws.append(item)
@@ -105,7 +155,7 @@ class Scene:
 
     @classmethod
     def demo(cls) -> Tuple["Scene", Camera]:
-        """The built-in demo: a lit, vertex-coloured cube on a checkered plane running to the horizon.
+        """The built-in demo: a lit, textured cube on a textured checker plane running to the horizon.
 
         Returns ``(scene, camera)``; the scene's ``clear_color`` is the sky colour. This is the scene
         the ``mipraster render`` command draws (it uses 4 samples per pixel, MSAA).

@@ -192,17 +192,45 @@ def test_demo(update_goldens):
     check("demo", mr.render(scene, camera, 128, 72, spp=4, aa="msaa"), update_goldens)
 
 
+# --- texture filtering: the demo's checker plane to the horizon with each filter -------------------------
+
+PLANE_FILTERS = ["nearest", "bilinear", "trilinear", "anisotropic", "ewa", "sat"]
+
+
+def plane_scene(sampler):
+    """The demo's ground (a 512² checker texture repeated 20 times over a 320-unit quad) alone,
+    seen from a low eye towards the horizon, with the given sampler."""
+    demo, _ = mr.Scene.demo()
+    ground = demo.draws[0]
+    scene = mr.Scene()
+    scene.clear_color = BACKGROUND
+    scene.add(ground.mesh, texture=ground.texture, sampler=sampler)
+    camera = mr.Camera.look_at(eye=(0.0, 1.5, 6.0), target=(0.0, 0.0, -20.0), fov_y=50.0)
+    return scene, camera
+
+
+@pytest.mark.parametrize("name", PLANE_FILTERS)
+def test_texture_filter(name, update_goldens):
+    scene, camera = plane_scene(name)
+    check(f"plane_{name}", mr.render(scene, camera, 128, 72), update_goldens)
+
+
+def test_mip_level_view(update_goldens):
+    scene, camera = plane_scene("trilinear")
+    check("plane_mip_levels", mr.render(scene, camera, 128, 72, debug_view="mip-level"), update_goldens)
+
+
 def test_every_golden_has_a_test_and_a_readme_entry():
     names = {p.stem for p in GOLDEN_DIR.glob("*.png")}
     expected = {"aa_1spp", "aa_msaa4_rotated", "aa_ssaa16_grid", "interp_flat", "interp_screen",
                 "interp_perspective", "blend_replace", "blend_add", "blend_over", "clip_near",
-                "depth_intersect", "demo"}
+                "depth_intersect", "demo", "plane_mip_levels"} | {f"plane_{f}" for f in PLANE_FILTERS}
     stray = {n for n in names if n.endswith((".actual", ".expected", ".diff"))}
     assert names - stray == expected
     readme = (GOLDEN_DIR / "README.md").read_text()
     for name in expected:
         assert f"`{name}.png`" in readme, name
-        assert (GOLDEN_DIR / f"{name}.png").stat().st_size < 8192, name
+        assert (GOLDEN_DIR / f"{name}.png").stat().st_size < 16384, name  # small: a few KiB, the textured demo 13 KiB
 
 
 # --- the harness ------------------------------------------------------------------------------------

@@ -77,7 +77,7 @@ def test_empty_mesh():
 
 def test_repr():
     assert repr(mr.Mesh(POSITIONS, TRIANGLES)) == "Mesh(vertices=4, triangles=2)"
-    assert repr(mr.Mesh(POSITIONS, TRIANGLES, np.ones((4, 3)))) == "Mesh(vertices=4, triangles=2, colors=RGBA)"
+    assert repr(mr.Mesh(POSITIONS, TRIANGLES, np.ones((4, 3)))) == "Mesh(vertices=4, triangles=2, colors)"
 
 
 # --- errors -------------------------------------------------------------------------------------
