@@ -19,8 +19,9 @@ namespace {
 
 // A file error from image_io (std::runtime_error naming the path) becomes OSError with .filename.
 [[noreturn]] void raise_os_error(const std::string& message, const std::string& path) {
-    py::object error = py::reinterpret_borrow<py::object>(PyExc_OSError)(message);
-    error.attr("filename") = path;
+    // OSError(errno, strerror, filename): str() shows the message and the path (an OSError built
+    // from the message alone and given .filename afterwards prints "[Errno None] None: ...").
+    py::object error = py::reinterpret_borrow<py::object>(PyExc_OSError)(py::none(), message, path);
     PyErr_SetObject(PyExc_OSError, error.ptr());
     throw py::error_already_set();
 }
@@ -74,21 +75,45 @@ py::dict load_scene_py(const std::string& path) {
 
     py::list meshes;
     for (const auto& mesh : scene.meshes) {
-        std::vector<float> positions(mesh->positions.size() * 3), colors(mesh->colors.size() * 4);
+        std::vector<float> positions(mesh->positions.size() * 3), colors(mesh->colors.size() * 4),
+            uvs(mesh->uvs.size() * 2), normals(mesh->normals.size() * 3);
         std::vector<std::uint32_t> triangles(mesh->triangles.size() * 3);
         for (std::size_t i = 0; i < mesh->positions.size(); ++i)
             for (int c = 0; c < 3; ++c) positions[3 * i + c] = mesh->positions[i][c];
         for (std::size_t i = 0; i < mesh->colors.size(); ++i)
             for (int c = 0; c < 4; ++c) colors[4 * i + c] = mesh->colors[i][c];
+        for (std::size_t i = 0; i < mesh->uvs.size(); ++i)
+            for (int c = 0; c < 2; ++c) uvs[2 * i + c] = mesh->uvs[i][c];
+        for (std::size_t i = 0; i < mesh->normals.size(); ++i)
+            for (int c = 0; c < 3; ++c) normals[3 * i + c] = mesh->normals[i][c];
         for (std::size_t i = 0; i < mesh->triangles.size(); ++i)
             for (int c = 0; c < 3; ++c) triangles[3 * i + c] = mesh->triangles[i][c];
         const auto n = static_cast<py::ssize_t>(mesh->positions.size());
         const auto t = static_cast<py::ssize_t>(mesh->triangles.size());
-        py::object cols = py::none();
+        py::object cols = py::none(), uv = py::none(), nrm = py::none();
         if (!mesh->colors.empty()) cols = vector_to_array(std::move(colors), {n, 4});
+        if (!mesh->uvs.empty()) uv = vector_to_array(std::move(uvs), {n, 2});
+        if (!mesh->normals.empty()) nrm = vector_to_array(std::move(normals), {n, 3});
         meshes.append(py::make_tuple(vector_to_array(std::move(positions), {n, 3}),
-                                     vector_to_array(std::move(triangles), {t, 3}), cols));
+                                     vector_to_array(std::move(triangles), {t, 3}), cols, uv, nrm));
     }
+    // Textures: level 0 of each distinct texture (draws sharing one share its index), as
+    // (name, (H, W, 4) float32 linear premultiplied RGBA). The Python layer makes mipraster.Texture
+    // objects of them (Texture lives in _core, which has its own texture cache).
+    py::list textures;
+    std::vector<const TextureLevel*> texture_keys;
+    auto texture_index = [&](const Texture& texture) -> py::object {
+        if (!texture) return py::none();
+        const TextureLevel* key = &texture.base_level();
+        for (std::size_t i = 0; i < texture_keys.size(); ++i)
+            if (texture_keys[i] == key) return py::int_(i);
+        std::vector<float> texels(key->texels.size() * 4);
+        for (std::size_t i = 0; i < key->texels.size(); ++i)
+            for (int c = 0; c < 4; ++c) texels[4 * i + c] = key->texels[i][c];
+        textures.append(py::make_tuple(texture.name(), vector_to_array(std::move(texels), {key->height, key->width, 4})));
+        texture_keys.push_back(key);
+        return py::int_(texture_keys.size() - 1);
+    };
     py::list draws;
     for (const Draw& d : scene.draws) {
         std::size_t index = 0;
@@ -100,11 +125,20 @@ py::dict load_scene_py(const std::string& path) {
         draw["color"] = from_vec4(d.color);
         draw["blend"] = to_string(d.state.blend);
         draw["cull"] = to_string(d.state.cull);
+        draw["texture"] = texture_index(d.texture);
+        py::dict sampler;
+        sampler["footprint"] = to_string(d.sampler.footprint);
+        sampler["mag_filter"] = to_string(d.sampler.mag_filter);
+        sampler["min_filter"] = to_string(d.sampler.min_filter);
+        sampler["mip_filter"] = to_string(d.sampler.mip_filter);
+        sampler["wrap"] = py::make_tuple(to_string(d.sampler.wrap_u), to_string(d.sampler.wrap_v));
+        draw["sampler"] = sampler;
         draws.append(draw);
     }
     py::dict out;
     out["meshes"] = meshes;
     out["draws"] = draws;
+    out["textures"] = textures;
     out["cameras"] = py::cast(scene.cameras);
     out["warnings"] = py::cast(scene.warnings);
     return out;
@@ -146,8 +180,11 @@ PYBIND11_MODULE(_image, m) {
         .def("__repr__", &NamedCamera::to_string);
     m.def("load_scene", &load_scene_py, py::arg("path"),
           "Loads a scene file (.obj, .gltf, .glb) into plain data: a dict with 'meshes' (list of\n"
-          "(positions (N, 3) float32, triangles (T, 3) uint32, colors (N, 4) float32 or None)), 'draws'\n"
-          "(list of dicts: mesh index, model 4x4, color RGBA, blend and cull names), 'cameras' (list of\n"
-          "NamedCamera) and 'warnings' (list of str). Textures are skipped. OSError (with .filename) for a\n"
+          "(positions (N, 3) float32, triangles (T, 3) uint32, colors (N, 4) float32 or None, uvs (N, 2)\n"
+          "float32 or None, normals (N, 3) float32 or None)), 'textures' (list of (name, (H, W, 4) float32\n"
+          "linear premultiplied RGBA)), 'draws' (list of dicts: mesh index, model 4x4, color RGBA, blend\n"
+          "and cull names, texture index or None, sampler dict: footprint, mag_filter, min_filter,\n"
+          "mip_filter names and wrap (u, v) names), 'cameras' (list of NamedCamera) and 'warnings' (list\n"
+          "of str: skipped features, missing textures drawn with the error texture). OSError (with .filename) for a\n"
           "missing, unreadable or corrupt file; ValueError for an unsupported extension or bad geometry.");
 }

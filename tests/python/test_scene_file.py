@@ -1,10 +1,12 @@
-"""mipraster.load_scene and `mipraster render SCENE`: OBJ and glTF files written by the tests."""
+"""mipraster.load_scene and `mipraster render SCENE`: OBJ and glTF files written by the tests,
+untextured and textured (uvs, base colour textures, samplers, missing textures)."""
 import base64
 import json
 import math
 import os
 import struct
 import subprocess
+import warnings
 
 import numpy as np
 import pytest
@@ -118,3 +120,134 @@ def test_cli_errors_name_the_file_or_camera(tmp_path):
     r = run("render", str(scene), "-o", str(tmp_path / "x.png"), "--camera", "3")
     assert r.returncode != 0
     assert "--camera 3" in r.stderr and "1 camera" in r.stderr
+
+
+# --- textures -------------------------------------------------------------------------------
+
+# The 2x2 test texture, linear RGBA: red, green / blue, white (every value exact in sRGB8).
+TEXELS = np.float32([[[1, 0, 0, 1], [0, 1, 0, 1]], [[0, 0, 1, 1], [1, 1, 1, 1]]])
+
+
+def write_texture(path):
+    mr.write_image(path, TEXELS)  # sRGB 8-bit PNG
+    return path
+
+
+def write_textured_gltf(path, image, sampler=None):
+    """A quad filling [-1, 1]^2 at z = 0 with uv (0, 0) at its top-left corner (x = -1, y = 1), the
+    texture `image` (a dict: {"uri": ...}), and an orthographic camera at z = 5 that sees exactly it."""
+    positions = [-1, 1, 0, 1, 1, 0, 1, -1, 0, -1, -1, 0]
+    uvs = [0, 0, 1, 0, 1, 1, 0, 1]
+    buf = struct.pack("<12f", *positions) + struct.pack("<8f", *uvs) + struct.pack("<6H", 0, 2, 1, 0, 3, 2)
+    doc = {
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}],
+        "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}],
+        "materials": [{"name": "checker", "doubleSided": True,
+                       "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+        "textures": [{"source": 0, **({} if sampler is None else {"sampler": 0})}],
+        "samplers": [] if sampler is None else [sampler],
+        "images": [image],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2, "material": 0}]}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"},
+        ],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
+                        {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+                        {"buffer": 0, "byteOffset": 80, "byteLength": 12}],
+        "buffers": [{"byteLength": len(buf) + 4,
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(buf + b"\0" * 4).decode()}],
+    }
+    path.write_text(json.dumps(doc))
+    return path
+
+
+NEAREST_CLAMP = {"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33648}
+
+
+def quadrant_colors(color):
+    """The colours at the centres of the four quadrants of a rendered image: TL, TR, BL, BR."""
+    h, w = color.shape[:2]
+    return [color[h // 4, w // 4], color[h // 4, 3 * w // 4], color[3 * h // 4, w // 4], color[3 * h // 4, 3 * w // 4]]
+
+
+def test_gltf_texture_renders_with_its_sampler(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    path = write_textured_gltf(tmp_path / "tex.gltf", {"uri": "checker.png"}, NEAREST_CLAMP)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a complete file loads without warnings
+        scene, cameras = mr.load_scene(path)
+    (d,) = scene.draws
+    np.testing.assert_array_equal(d.mesh.uvs, [[0, 0], [1, 0], [1, 1], [0, 1]])
+    assert d.texture is not None and (d.texture.width, d.texture.height) == (2, 2)
+    assert d.texture.name == str(tmp_path / "checker.png")
+    np.testing.assert_allclose(d.texture.level(0), TEXELS, atol=1e-6)  # decoded back to linear
+    s = d.sampler
+    # NEAREST / NEAREST (no mip levels) is the "nearest" preset; the wraps are per axis.
+    assert s == mr.Sampler(filter="nearest", wrap=("clamp", "mirror"))
+    assert not s.uses_mip_levels
+    result = mr.render(scene, cameras[0], 32, 32)
+    got = quadrant_colors(result.color)
+    for q, expected in enumerate([TEXELS[0, 0], TEXELS[0, 1], TEXELS[1, 0], TEXELS[1, 1]]):
+        np.testing.assert_allclose(got[q], expected, atol=1e-6, err_msg=f"quadrant {q}")
+
+
+def test_gltf_embedded_texture_and_default_sampler(tmp_path):
+    png = write_texture(tmp_path / "src.png").read_bytes()
+    image = {"uri": "data:image/png;base64," + base64.b64encode(png).decode()}
+    scene, cameras = mr.load_scene(write_textured_gltf(tmp_path / "embedded.gltf", image))
+    (d,) = scene.draws
+    np.testing.assert_allclose(d.texture.level(0), TEXELS, atol=1e-6)
+    s = d.sampler  # no glTF sampler: the library default (trilinear, repeat)
+    assert s == mr.Sampler()
+    color = mr.render(scene, cameras[0], 64, 64).color
+    # Bilinear magnification: the quadrant centres are close to the texels' colours.
+    got = quadrant_colors(color)
+    for q, expected in enumerate([TEXELS[0, 0], TEXELS[0, 1], TEXELS[1, 0], TEXELS[1, 1]]):
+        assert np.abs(got[q] - expected).max() < 0.05, (q, got[q])
+
+
+def test_obj_texture_flips_v(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    (tmp_path / "m.mtl").write_text("newmtl tex\nKd 1 1 1\nmap_Kd checker.png\n")
+    path = tmp_path / "quad.obj"
+    # OBJ's vt (0, 0) is the image's bottom-left corner: put it at the quad's bottom-left.
+    path.write_text("mtllib m.mtl\n"
+                    "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+                    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+                    "usemtl tex\nf 1/1/1 2/2/1 3/3/1 4/4/1\n")
+    scene, cameras = mr.load_scene(path)
+    assert cameras == []
+    (d,) = scene.draws
+    assert d.texture is not None and d.sampler == mr.Sampler()
+    np.testing.assert_array_equal(d.mesh.uvs[d.mesh.positions[:, 0].argmin()], [0, 1])  # a left corner ...
+    np.testing.assert_array_equal(d.mesh.normals, np.tile([0, 0, 1], (4, 1)))
+    camera = mr.Camera.orthographic((0, 0, 5), (0, 0, 0), height=2.0, near=0.1, far=10)
+    got = quadrant_colors(mr.render(scene, camera, 64, 64).color)
+    # Upright: the image's top row (red, green) is at the top of the render.
+    for q, expected in enumerate([TEXELS[0, 0], TEXELS[0, 1], TEXELS[1, 0], TEXELS[1, 1]]):
+        assert np.abs(got[q] - expected).max() < 0.05, (q, got[q])
+
+
+def test_missing_texture_warns_and_renders_the_error_texture(tmp_path):
+    path = write_textured_gltf(tmp_path / "missing.gltf", {"uri": "nowhere.png"}, NEAREST_CLAMP)
+    with pytest.warns(UserWarning, match=r"material 'checker'.*nowhere\.png"):
+        scene, cameras = mr.load_scene(path)
+    (d,) = scene.draws
+    assert d.texture.name == "error texture" and (d.texture.width, d.texture.height) == (8, 8)
+    color = mr.render(scene, cameras[0], 16, 16).color  # one texel per 2x2 pixels, nearest
+    np.testing.assert_allclose(color[0, 0], [1, 0, 1, 1], atol=1e-6)  # magenta
+    np.testing.assert_allclose(color[0, 2], [0, 0, 0, 1], atol=1e-6)  # black
+
+
+def test_hostile_texture_reference_is_an_error_naming_the_file(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    path = write_textured_gltf(tmp_path / "bad_sampler.gltf", {"uri": "checker.png"}, NEAREST_CLAMP)
+    doc = json.loads(path.read_text())
+    doc["textures"][0]["sampler"] = 4
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=r"bad_sampler\.gltf.*sampler 4 does not exist"):
+        mr.load_scene(path)

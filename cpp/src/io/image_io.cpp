@@ -2,6 +2,7 @@
 
 #include "file_extension.hpp"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <array>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <vector>
@@ -17,6 +19,11 @@
 
 namespace mipraster {
 namespace {
+
+/// Largest image read_image decodes, in pixels: 2^29 is the largest texture level 0 (8 GiB of
+/// RGBA float, kMaxTextureBytes); a file claiming more is refused before anything is allocated.
+constexpr std::uint64_t kMaxReadPixels = std::uint64_t{1} << 29;
+static_assert(kMaxReadPixels * 16 <= (std::uint64_t{8} << 30), "read limit must fit the texture limit");
 
 enum class FileKind { png, exr };
 
@@ -108,42 +115,41 @@ void write_image(const std::string& path, const Image& image) {
     write_pixels(path, spec, OIIO::TypeDesc::UINT8, bytes.data());
 }
 
-Image read_image(const std::string& path) {
-    // Step: open. Ask for the file's own (straight) alpha so that we premultiply in linear space.
-    OIIO::ImageSpec config;
-    config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = OIIO::ImageInput::open(path, &config);
-    if (!in) {
-        std::string message = OIIO::geterror();
-        std::error_code ec;
-        if (!std::filesystem::exists(path, ec)) message = "no such file";
-        throw std::runtime_error("read_image: cannot read '" + path + "': " + message);
-    }
-    const OIIO::ImageSpec spec = in->spec();
+namespace {
+
+// Step: read every channel of an opened file, decode and premultiply (read_image's contract;
+// `options` says how integer colour and alpha are taken). `name` is the path or the memory
+// image's name, for messages.
+Image decode_image(OIIO::ImageInput& in, const std::string& name, const ImageReadOptions& options) {
+    const OIIO::ImageSpec spec = in.spec();
     const int w = spec.width, h = spec.height, nch = spec.nchannels;
     if (w <= 0 || h <= 0 || nch <= 0)
-        throw std::runtime_error("read_image: '" + path + "' has no pixels (" + std::to_string(w) + "x" +
+        throw std::runtime_error("read_image: '" + name + "' has no pixels (" + std::to_string(w) + "x" +
                                  std::to_string(h) + "x" + std::to_string(nch) + ")");
+    const std::uint64_t values = std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(nch);
+    if (std::uint64_t(w) * std::uint64_t(h) > kMaxReadPixels)
+        throw std::runtime_error("read_image: '" + name + "' is too large (" + std::to_string(w) + "x" +
+                                 std::to_string(h) + " pixels; at most " + std::to_string(kMaxReadPixels) + ")");
 
-    // Step: read every channel as float in [0, 1] (integers) or as stored (floats).
+    // Read every channel as float in [0, 1] (integers) or as stored (floats).
     const OIIO::TypeDesc stored = spec.format;
     const bool is_float = stored.basetype == OIIO::TypeDesc::FLOAT || stored.basetype == OIIO::TypeDesc::HALF ||
                           stored.basetype == OIIO::TypeDesc::DOUBLE;
     const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-    std::vector<float> raw(n * static_cast<std::size_t>(nch));
+    std::vector<float> raw(static_cast<std::size_t>(values));
     bool ok = true;
     if (stored == OIIO::TypeDesc::UINT8) {
         // 8-bit: convert code / 255 ourselves so that decoding is exact and independent of OIIO.
         std::vector<std::uint8_t> bytes(raw.size());
-        ok = in->read_image(0, 0, 0, nch, OIIO::TypeDesc::UINT8, bytes.data());
+        ok = in.read_image(0, 0, 0, nch, OIIO::TypeDesc::UINT8, bytes.data());
         for (std::size_t i = 0; i < raw.size(); ++i) raw[i] = static_cast<float>(bytes[i]) / 255.0f;
     } else {
-        ok = in->read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, raw.data());
+        ok = in.read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, raw.data());
     }
-    if (!ok) throw std::runtime_error("read_image: cannot read pixels of '" + path + "': " + in->geterror());
-    in->close();
+    if (!ok) throw std::runtime_error("read_image: cannot read pixels of '" + name + "': " + in.geterror());
+    in.close();
 
-    // Step: pick the colour and alpha channels.
+    // Pick the colour and alpha channels.
     int alpha = spec.alpha_channel;
     if (alpha < 0 || alpha >= nch) alpha = nch == 2 ? 1 : (nch >= 4 ? 3 : -1);
     if (nch == 1) alpha = -1;  // a single channel is grey, whatever it is named
@@ -153,7 +159,8 @@ Image read_image(const std::string& path) {
         if (c != alpha) colour[found++] = c;
     if (found < 3) colour = {colour[0], colour[0], colour[0]};  // grey (or grey + alpha)
 
-    // Step: decode sRGB for integer files and premultiply; float files are taken as they are.
+    // Decode integer files (sRGB or linear codes) and premultiply; float files are taken as
+    // they are (already premultiplied). ignore_alpha: alpha 1 and the straight colour.
     Image image(w, h, 4);
     for (std::size_t p = 0; p < n; ++p) {
         const float* src = &raw[p * nch];
@@ -161,11 +168,69 @@ Image read_image(const std::string& path) {
         const float a = alpha >= 0 ? src[alpha] : 1.0f;
         for (int c = 0; c < 3; ++c) {
             const float v = src[colour[c]];
-            dst[c] = is_float ? v : srgb_to_linear(v) * a;
+            if (is_float) {
+                dst[c] = options.ignore_alpha && a > 0.0f ? v / a : v;  // un-premultiply to drop alpha
+            } else {
+                const float linear = options.srgb ? srgb_to_linear(v) : v;
+                dst[c] = options.ignore_alpha ? linear : linear * a;
+            }
         }
-        dst[3] = a;
+        dst[3] = options.ignore_alpha ? 1.0f : a;
     }
     return image;
+}
+
+// The file format's extension, from the first bytes (OpenImageIO picks its reader by name).
+std::string sniff_extension(const unsigned char* b, std::size_t size) {
+    auto starts = [&](const char* magic, std::size_t n) { return size >= n && std::memcmp(b, magic, n) == 0; };
+    if (starts("\x89PNG\r\n\x1a\n", 8)) return ".png";
+    if (starts("\xff\xd8\xff", 3)) return ".jpg";
+    if (starts("v/1\x01", 4)) return ".exr";
+    if (starts("RIFF", 4) && size >= 12 && std::memcmp(b + 8, "WEBP", 4) == 0) return ".webp";
+    if (starts("GIF8", 4)) return ".gif";
+    if (starts("BM", 2)) return ".bmp";
+    if (starts("II*\0", 4) || starts("MM\0*", 4)) return ".tif";
+    if (starts("#?RADIANCE", 10) || starts("#?RGBE", 6)) return ".hdr";
+    return "";
+}
+
+}  // namespace
+
+Image read_image(const std::string& path) { return read_image(path, ImageReadOptions{}); }
+
+Image read_image(const std::string& path, const ImageReadOptions& options) {
+    // Open, asking for the file's own (straight) alpha so that we premultiply in linear space.
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
+    if (!in) {
+        std::string message = OIIO::geterror();
+        std::error_code ec;
+        if (!std::filesystem::exists(path, ec)) message = "no such file";
+        throw std::runtime_error("read_image: cannot read '" + path + "': " + message);
+    }
+    return decode_image(*in, path, options);
+}
+
+Image read_image_from_memory(const void* bytes, std::size_t size, const std::string& name,
+                             const ImageReadOptions& options) {
+    if (size == 0 || bytes == nullptr) throw std::runtime_error("read_image: '" + name + "' is empty (0 bytes)");
+    const auto* b = static_cast<const unsigned char*>(bytes);
+    const std::string ext = sniff_extension(b, size);
+    if (ext.empty())
+        throw std::runtime_error("read_image: cannot read '" + name +
+                                 "': not a recognized image format (expected PNG, JPEG, EXR, WebP, GIF, BMP, TIFF or HDR)");
+    OIIO::Filesystem::IOMemReader proxy(b, size);
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    // The proxy goes in the configuration hints as well: OpenImageIO 2.4's readers take it from
+    // there when open() is given hints (the open() argument alone is dropped).
+    OIIO::Filesystem::IOProxy* proxy_pointer = &proxy;
+    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_pointer);
+    // The name only tells OpenImageIO the format; the bytes come from the proxy.
+    auto in = OIIO::ImageInput::open("memory" + ext, &config, &proxy);
+    if (!in) throw std::runtime_error("read_image: cannot read '" + name + "': " + OIIO::geterror());
+    return decode_image(*in, name, options);
 }
 
 }  // namespace mipraster

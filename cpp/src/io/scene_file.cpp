@@ -3,16 +3,20 @@
 #include "mipraster/io/scene_file.hpp"
 
 #include "file_extension.hpp"
+#include "mipraster/io/texture_file.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
 #include <utility>
 
 #include <glm/gtc/quaternion.hpp>
@@ -59,6 +63,30 @@ void add_warnings(std::vector<std::string>& out, const std::string& path, const 
 // ---------------------------------------------------------------------------------------------
 // OBJ
 // ---------------------------------------------------------------------------------------------
+/// One OBJ face corner: position, texture coordinate and normal indices (−1: none).
+struct ObjCorner {
+    int v = -1, t = -1, n = -1;
+    bool operator==(const ObjCorner& o) const { return v == o.v && t == o.t && n == o.n; }
+};
+
+struct ObjCornerHash {
+    std::size_t operator()(const ObjCorner& c) const {
+        std::uint64_t h = static_cast<std::uint32_t>(c.v);
+        h = h * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint32_t>(c.t);
+        h = h * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint32_t>(c.n);
+        return static_cast<std::size_t>(h ^ (h >> 29));
+    }
+};
+
+/// The triangles of one OBJ draw: a material's faces (textured materials split into the faces
+/// with texture coordinates, drawn textured, and those without).
+struct ObjGroup {
+    int material = -1;
+    bool textured = false;
+    std::vector<std::array<ObjCorner, 3>> triangles;
+    bool all_uvs = true, all_normals = true;  // every corner has one
+};
+
 LoadedScene load_obj(const std::string& path) {
     tinyobj::attrib_t attrib;
     std::vector<tinyobj::shape_t> shapes;
@@ -74,12 +102,19 @@ LoadedScene load_obj(const std::string& path) {
     add_warnings(scene.warnings, path, warn);
 
     const std::size_t vertex_count = attrib.vertices.size() / 3;
+    const std::size_t uv_count = attrib.texcoords.size() / 2;
+    const std::size_t normal_count = attrib.normals.size() / 3;
     if (vertex_count > kMaxElements) fail(path, "too many vertices (" + std::to_string(vertex_count) + ")");
     const bool has_colors = !attrib.colors.empty() && attrib.colors.size() == attrib.vertices.size();
+    auto material_name = [&](int material) {
+        return material < 0 ? std::string("default material") : "material '" + materials[material].name + "'";
+    };
+    auto is_textured = [&](int material) { return material >= 0 && !materials[material].diffuse_texname.empty(); };
 
-    // Step 1: gather triangles per material (−1: none) in order of first use.
-    std::vector<int> material_order;
-    std::map<int, std::vector<glm::uvec3>> by_material;  // corners as OBJ vertex indices
+    // Step 1: gather triangles per (material, textured) in order of first use. A textured
+    // material's faces without texture coordinates go to its untextured group.
+    std::vector<ObjGroup> groups;
+    std::map<std::pair<int, bool>, std::size_t> group_of;
     for (std::size_t s = 0; s < shapes.size(); ++s) {
         const tinyobj::mesh_t& m = shapes[s].mesh;
         std::size_t offset = 0;
@@ -87,61 +122,129 @@ LoadedScene load_obj(const std::string& path) {
             const std::size_t n = m.num_face_vertices[f];
             if (offset + n > m.indices.size()) fail(path, "shape '" + shapes[s].name + "': face indices truncated");
             if (n == 3) {
-                glm::uvec3 tri;
+                std::array<ObjCorner, 3> tri;
+                bool face_uvs = true, face_normals = true;
                 for (int c = 0; c < 3; ++c) {
-                    const int vi = m.indices[offset + c].vertex_index;
-                    if (vi < 0 || static_cast<std::size_t>(vi) >= vertex_count)
-                        fail(path, "shape '" + shapes[s].name + "' face " + std::to_string(f) + ": vertex index " +
-                                       std::to_string(vi + 1) + " out of range (the file has " +
-                                       std::to_string(vertex_count) + " vertices)");
-                    tri[c] = static_cast<std::uint32_t>(vi);
+                    const tinyobj::index_t& idx = m.indices[offset + c];
+                    auto check = [&](int i, std::size_t count, const char* what) {
+                        if (i < 0 || static_cast<std::size_t>(i) >= count)
+                            fail(path, "shape '" + shapes[s].name + "' face " + std::to_string(f) + ": " + what +
+                                           " index " + std::to_string(i + 1) + " out of range (the file has " +
+                                           std::to_string(count) + ")");
+                    };
+                    check(idx.vertex_index, vertex_count, "vertex");
+                    if (idx.texcoord_index >= 0) check(idx.texcoord_index, uv_count, "texture coordinate");
+                    if (idx.normal_index >= 0) check(idx.normal_index, normal_count, "normal");
+                    tri[c] = ObjCorner{idx.vertex_index, idx.texcoord_index, idx.normal_index};
+                    face_uvs &= idx.texcoord_index >= 0;
+                    face_normals &= idx.normal_index >= 0;
                 }
                 int material = f < m.material_ids.size() ? m.material_ids[f] : -1;
                 if (material < 0 || static_cast<std::size_t>(material) >= materials.size()) material = -1;
-                auto it = by_material.find(material);
-                if (it == by_material.end()) {
-                    material_order.push_back(material);
-                    it = by_material.emplace(material, std::vector<glm::uvec3>{}).first;
+                const bool textured = is_textured(material) && face_uvs;
+                auto it = group_of.find({material, textured});
+                if (it == group_of.end()) {
+                    it = group_of.emplace(std::make_pair(material, textured), groups.size()).first;
+                    groups.push_back(ObjGroup{material, textured, {}, true, true});
                 }
-                it->second.push_back(tri);
+                ObjGroup& g = groups[it->second];
+                g.triangles.push_back(tri);
+                g.all_uvs &= face_uvs;
+                g.all_normals &= face_normals;
             }
             offset += n;
         }
     }
 
-    // Step 2: one compact mesh and draw per material.
-    for (int material : material_order) {
-        const std::vector<glm::uvec3>& tris = by_material[material];
+    // Step 2: one compact mesh and draw per group; vertices are split by their (position,
+    // texture coordinate, normal) indices, those the group keeps.
+    std::map<int, Texture> textures;  // by material
+    for (ObjGroup& g : groups) {
+        const std::string name = material_name(g.material);
+        const bool keep_uvs = g.all_uvs && (g.textured || !is_textured(g.material));
+        const bool keep_normals = g.all_normals;
+        if (is_textured(g.material) && !g.textured)
+            scene.warnings.push_back(path + ": " + name + ": " + std::to_string(g.triangles.size()) +
+                                     " triangle(s) have no texture coordinates; they are drawn without its map_Kd "
+                                     "texture");
+
+        // The material's texture options: -s/-o scale and offset uvs (baked in), -clamp on
+        // clamps, -colorspace linear marks data.
+        glm::vec2 uv_scale(1.0f), uv_offset(0.0f);
+        Sampler sampler;
+        TextureFileOptions options;
+        options.ignore_alpha = true;  // OBJ draws are opaque
+        if (g.textured) {
+            const tinyobj::texture_option_t& o = materials[g.material].diffuse_texopt;
+            uv_scale = glm::vec2(o.scale[0], o.scale[1]);
+            uv_offset = glm::vec2(o.origin_offset[0], o.origin_offset[1]);
+            if (!std::isfinite(uv_scale.x) || !std::isfinite(uv_scale.y) || !std::isfinite(uv_offset.x) ||
+                !std::isfinite(uv_offset.y))
+                fail(path, name + ": map_Kd -s/-o options are not finite");
+            if (o.clamp) sampler.wrap_u = sampler.wrap_v = WrapMode::clamp;
+            std::string colorspace = o.colorspace;
+            for (char& c : colorspace) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+            options.srgb = colorspace != "linear";
+        }
+
         auto mesh = std::make_shared<Mesh>();
-        std::vector<std::uint32_t> remap(vertex_count, std::numeric_limits<std::uint32_t>::max());
-        mesh->triangles.reserve(tris.size());
-        for (const glm::uvec3& t : tris) {
+        std::unordered_map<ObjCorner, std::uint32_t, ObjCornerHash> remap;
+        mesh->triangles.reserve(g.triangles.size());
+        for (const auto& t : g.triangles) {
             glm::uvec3 out;
             for (int c = 0; c < 3; ++c) {
-                std::uint32_t& r = remap[t[c]];
-                if (r == std::numeric_limits<std::uint32_t>::max()) {
-                    r = static_cast<std::uint32_t>(mesh->positions.size());
-                    const std::size_t v = t[c];
+                const ObjCorner key{t[c].v, keep_uvs ? t[c].t : -1, keep_normals ? t[c].n : -1};
+                auto [it, inserted] = remap.emplace(key, static_cast<std::uint32_t>(mesh->positions.size()));
+                if (inserted) {
+                    const std::size_t v = static_cast<std::size_t>(key.v);
                     mesh->positions.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
                                                  attrib.vertices[3 * v + 2]);
                     if (has_colors)
                         mesh->colors.emplace_back(attrib.colors[3 * v], attrib.colors[3 * v + 1],
                                                   attrib.colors[3 * v + 2], 1.0f);
+                    if (keep_uvs) {
+                        const std::size_t i = static_cast<std::size_t>(key.t);
+                        const glm::vec2 uv = glm::vec2(attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]) * uv_scale +
+                                             uv_offset;
+                        mesh->uvs.emplace_back(uv.x, 1.0f - uv.y);  // OBJ's v runs up the image, ours down
+                    }
+                    if (keep_normals) {
+                        const std::size_t i = static_cast<std::size_t>(key.n);
+                        mesh->normals.emplace_back(attrib.normals[3 * i], attrib.normals[3 * i + 1],
+                                                   attrib.normals[3 * i + 2]);
+                    }
                 }
-                out[c] = r;
+                out[c] = it->second;
             }
             mesh->triangles.push_back(out);
         }
-        const std::string name =
-            material < 0 ? std::string("default material") : "material '" + materials[material].name + "'";
         mesh->validate(path + " (" + name + ")");
         Draw draw;
         draw.mesh = mesh.get();
-        if (material >= 0) {
-            const auto& kd = materials[material].diffuse;
+        if (g.material >= 0) {
+            const auto& kd = materials[g.material].diffuse;
             draw.color = glm::vec4(kd[0], kd[1], kd[2], 1.0f);
             for (int c = 0; c < 3; ++c)
                 if (!std::isfinite(kd[c])) fail(path, name + ": Kd is not finite");
+        }
+        if (g.textured) {
+            auto it = textures.find(g.material);
+            if (it == textures.end()) {
+                std::string file = materials[g.material].diffuse_texname;
+                std::replace(file.begin(), file.end(), '\\', '/');  // MTL files written on Windows
+                if (file.empty() || file[0] != '/') file = base + file;
+                Texture texture;
+                try {
+                    texture = load_texture(file, options);
+                } catch (const std::exception& e) {  // missing, unreadable, corrupt or too large
+                    scene.warnings.push_back(path + ": " + name + ": cannot load its map_Kd texture '" + file + "' (" +
+                                             e.what() + "); drawing the error texture instead");
+                    texture = error_texture();
+                }
+                it = textures.emplace(g.material, texture).first;
+            }
+            draw.texture = it->second;
+            draw.sampler = sampler;
         }
         scene.meshes.push_back(std::move(mesh));
         scene.draws.push_back(draw);
@@ -153,9 +256,42 @@ LoadedScene load_obj(const std::string& path) {
 // glTF
 // ---------------------------------------------------------------------------------------------
 
-// Images are not decoded (textures come later): accept every image without touching its bytes.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+/// The encoded bytes of data-URI images, by image index, kept by keep_data_uri_image.
+struct EmbeddedImages {
+    std::map<int, std::vector<unsigned char>> bytes;
+};
+
+// tinygltf's image callback: decode nothing (textures are decoded by the io module's
+// load_texture through OpenImageIO). Only data-URI images are kept, as encoded bytes: external
+// files are read again relative to the glTF file by load_texture (which shares them), and
+// bufferView images are read from their buffer, with bounds checks, by the loader (tinygltf
+// passes a pointer it has not checked, so it is not touched here).
+bool keep_data_uri_image(tinygltf::Image* image, const int index, std::string*, std::string*, int, int,
+                         const unsigned char* bytes, int size, void* user) {
+    if (image->uri.empty() && image->bufferView < 0 && bytes != nullptr && size > 0)
+        static_cast<EmbeddedImages*>(user)->bytes[index].assign(bytes, bytes + size);
     return true;
+}
+
+/// A URI reference with its %XX escapes decoded (glTF URIs are percent-encoded); an invalid
+/// escape is kept as it is.
+std::string percent_decode(const std::string& uri) {
+    auto hex = [](char c) {
+        if (c >= '0' && c <= '9') return c - '0';
+        if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+        if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+        return -1;
+    };
+    std::string out;
+    for (std::size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && hex(uri[i + 1]) >= 0 && hex(uri[i + 2]) >= 0) {
+            out += static_cast<char>(hex(uri[i + 1]) * 16 + hex(uri[i + 2]));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
 }
 
 /// Reads an accessor's elements as doubles (normalized integers mapped to [0, 1] / [−1, 1]),
@@ -287,12 +423,201 @@ glm::dmat4 node_matrix(const tinygltf::Node& node, const std::string& path, int 
 struct GltfLoader {
     const tinygltf::Model& model;
     const std::string& path;
+    const EmbeddedImages& embedded;
     LoadedScene scene;
     std::map<std::pair<int, int>, std::shared_ptr<Mesh>> mesh_cache;  // (mesh, primitive) → mesh
+    std::map<std::pair<int, bool>, Texture> texture_cache;            // (image, ignore alpha) → texture
+    std::set<std::string> warned;                                     // warnings given once
     std::size_t skipped_primitives = 0;
     std::vector<bool> on_path;  // nodes on the current root-to-node path (cycle detection)
 
-    GltfLoader(const tinygltf::Model& m, const std::string& p) : model(m), path(p), on_path(m.nodes.size(), false) {}
+    GltfLoader(const tinygltf::Model& m, const std::string& p, const EmbeddedImages& e)
+        : model(m), path(p), embedded(e), on_path(m.nodes.size(), false) {}
+
+    void warn_once(const std::string& message) {
+        if (warned.insert(message).second) scene.warnings.push_back(path + ": " + message);
+    }
+
+    static std::string material_name(const tinygltf::Material& mat, int index) {
+        const std::string where = "materials[" + std::to_string(index) + "]";
+        return mat.name.empty() ? "material " + where : "material '" + mat.name + "' (" + where + ")";
+    }
+
+    /// The draw's colour, blending, culling, base colour texture and sampler from its material.
+    void apply_material(Draw& draw, const tinygltf::Primitive& prim, int mesh_index, int prim_index) {
+        const std::string prim_what =
+            "meshes[" + std::to_string(mesh_index) + "].primitives[" + std::to_string(prim_index) + "]";
+        if (prim.material < 0) {
+            draw.state.cull = CullMode::back;  // the default material is single-sided
+            return;
+        }
+        if (static_cast<std::size_t>(prim.material) >= model.materials.size())
+            fail(path, prim_what + ": material " + std::to_string(prim.material) + " does not exist (the file has " +
+                           std::to_string(model.materials.size()) + ")");
+        const tinygltf::Material& mat = model.materials[prim.material];
+        const std::string name = material_name(mat, prim.material);
+        const std::vector<double>& f = mat.pbrMetallicRoughness.baseColorFactor;
+        if (f.size() != 4) fail(path, name + ": baseColorFactor must have 4 numbers");
+        for (double v : f)
+            if (!std::isfinite(v)) fail(path, name + ": baseColorFactor is not finite");
+        const bool blend = mat.alphaMode == "BLEND";
+        if (blend) {
+            draw.color = glm::vec4(f[0] * f[3], f[1] * f[3], f[2] * f[3], f[3]);
+            draw.state.blend = BlendMode::over;
+        } else {
+            draw.color = glm::vec4(f[0], f[1], f[2], 1.0);
+        }
+        if (!mat.doubleSided) draw.state.cull = CullMode::back;
+
+        // Base colour texture: TEXCOORD_0 only.
+        const tinygltf::TextureInfo& info = mat.pbrMetallicRoughness.baseColorTexture;
+        if (info.index < 0) return;
+        if (static_cast<std::size_t>(info.index) >= model.textures.size())
+            fail(path, name + ": baseColorTexture index " + std::to_string(info.index) +
+                           " does not exist (the file has " + std::to_string(model.textures.size()) + " textures)");
+        if (info.texCoord != 0) {
+            warn_once(name + ": baseColorTexture uses TEXCOORD_" + std::to_string(info.texCoord) +
+                      "; only TEXCOORD_0 is supported, so it is drawn without the texture");
+            return;
+        }
+        if (info.extensions.count("KHR_texture_transform"))
+            warn_once(name + ": KHR_texture_transform is not supported; the texture is drawn untransformed");
+        const tinygltf::Texture& tex = model.textures[info.index];
+        const std::string tex_what = "textures[" + std::to_string(info.index) + "]";
+        Sampler sampler = sampler_of(tex.sampler, tex_what);  // checks the index even when unused below
+        if (tex.source >= 0 && static_cast<std::size_t>(tex.source) >= model.images.size())
+            fail(path, tex_what + ": source image " + std::to_string(tex.source) + " does not exist (the file has " +
+                           std::to_string(model.images.size()) + " images)");
+        if (!draw.mesh->has_uvs()) {
+            warn_once(prim_what + " has no TEXCOORD_0 but its " + name +
+                      " has a baseColorTexture; drawn without the texture");
+            return;
+        }
+        if (tex.source < 0) {
+            warn_once(tex_what + " (used by " + name +
+                      ") has no source image (only extension images such as KTX2/WebP?); drawn without it");
+            return;
+        }
+        draw.texture = image_texture(tex.source, name, /*ignore_alpha=*/!blend);
+        draw.sampler = sampler;
+    }
+
+    /// glTF sampler → Sampler. Undefined filters keep the library default (trilinear); undefined
+    /// wraps are REPEAT. Unknown enum values are warned about and replaced by the defaults.
+    Sampler sampler_of(int index, const std::string& tex_what) {
+        Sampler s;
+        if (index < 0) return s;
+        if (static_cast<std::size_t>(index) >= model.samplers.size())
+            fail(path, tex_what + ": sampler " + std::to_string(index) + " does not exist (the file has " +
+                           std::to_string(model.samplers.size()) + " samplers)");
+        const tinygltf::Sampler& g = model.samplers[index];
+        const std::string what = "samplers[" + std::to_string(index) + "]";
+        auto wrap = [&](int mode, const char* field) {
+            switch (mode) {
+                case TINYGLTF_TEXTURE_WRAP_REPEAT: return WrapMode::repeat;
+                case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return WrapMode::clamp;
+                case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return WrapMode::mirror;
+                default:
+                    warn_once(what + ": " + field + " " + std::to_string(mode) + " is not a glTF wrap mode; using REPEAT");
+                    return WrapMode::repeat;
+            }
+        };
+        s.wrap_u = wrap(g.wrapS, "wrapS");
+        s.wrap_v = wrap(g.wrapT, "wrapT");
+        switch (g.magFilter) {
+            case -1: break;
+            case TINYGLTF_TEXTURE_FILTER_NEAREST: s.mag_filter = TexelFilter::nearest; break;
+            case TINYGLTF_TEXTURE_FILTER_LINEAR: s.mag_filter = TexelFilter::linear; break;
+            default:
+                warn_once(what + ": magFilter " + std::to_string(g.magFilter) + " is not a glTF filter; using LINEAR");
+        }
+        // minFilter = texel filter within a level + filter between levels.
+        switch (g.minFilter) {
+            case -1: break;
+            case TINYGLTF_TEXTURE_FILTER_NEAREST: s.min_filter = TexelFilter::nearest, s.mip_filter = MipFilter::none; break;
+            case TINYGLTF_TEXTURE_FILTER_LINEAR: s.min_filter = TexelFilter::linear, s.mip_filter = MipFilter::none; break;
+            case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST:
+                s.min_filter = TexelFilter::nearest, s.mip_filter = MipFilter::nearest;
+                break;
+            case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST:
+                s.min_filter = TexelFilter::linear, s.mip_filter = MipFilter::nearest;
+                break;
+            case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR:
+                s.min_filter = TexelFilter::nearest, s.mip_filter = MipFilter::linear;
+                break;
+            case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR:
+                s.min_filter = TexelFilter::linear, s.mip_filter = MipFilter::linear;
+                break;
+            default:
+                warn_once(what + ": minFilter " + std::to_string(g.minFilter) +
+                          " is not a glTF filter; using LINEAR_MIPMAP_LINEAR");
+        }
+        return s;
+    }
+
+    /// The texture of image `index` (sRGB colour; alpha ignored for opaque materials), decoded once
+    /// per load. An image that cannot be read gives the error texture and a warning naming the
+    /// material and the file; an image whose bufferView lies outside its buffer is an error.
+    Texture image_texture(int index, const std::string& material, bool ignore_alpha) {
+        const auto key = std::make_pair(index, ignore_alpha);
+        if (auto it = texture_cache.find(key); it != texture_cache.end()) return it->second;
+        const tinygltf::Image& image = model.images[index];
+        const std::string what = "images[" + std::to_string(index) + "]" + (image.name.empty() ? "" : " ('" + image.name + "')");
+        TextureFileOptions options;
+        options.srgb = true;  // glTF base colour textures are sRGB
+        options.ignore_alpha = ignore_alpha;
+        Texture texture;
+        std::string source;  // the file or the embedded image, for the warning
+        const unsigned char* view_bytes = nullptr;
+        std::size_t view_size = 0;
+        if (image.uri.empty() && image.bufferView >= 0)
+            buffer_view_bytes(image.bufferView, what, view_bytes, view_size);  // a bad view is an error, not a warning
+        try {
+            if (!image.uri.empty()) {
+                if (image.uri.rfind("data:", 0) == 0) {  // tinygltf decodes PNG, JPEG, BMP and GIF data URIs only
+                    source = what + " (data URI)";
+                    const std::string type = image.uri.substr(5, std::min<std::size_t>(image.uri.find_first_of(";,"), 64) - 5);
+                    throw std::runtime_error("data URI of media type '" + type + "' is not supported");
+                }
+                const std::string uri = percent_decode(image.uri);
+                source = "'" + uri + "'";
+                if (uri.find("://") != std::string::npos)
+                    throw std::runtime_error("only relative file URIs are supported");
+                source = "'" + directory_of(path) + uri + "'";
+                texture = load_texture(directory_of(path) + uri, options);
+            } else if (image.bufferView >= 0) {
+                source = what + " (bufferView " + std::to_string(image.bufferView) + ")";
+                texture = load_texture_from_memory(view_bytes, view_size, path + " " + what, options);
+            } else {
+                source = what + " (data URI)";
+                const auto it = embedded.bytes.find(index);
+                if (it == embedded.bytes.end()) throw std::runtime_error("the data URI holds no bytes");
+                texture = load_texture_from_memory(it->second.data(), it->second.size(), path + " " + what, options);
+            }
+        } catch (const std::exception& e) {  // missing, unreadable, corrupt or too large
+            warn_once(material + ": cannot load its base colour texture " + source + " (" + e.what() +
+                      "); drawing the error texture instead");
+            texture = error_texture();
+        }
+        texture_cache.emplace(key, texture);
+        return texture;
+    }
+
+    /// The bytes of a bufferView, after checking that they lie inside its buffer.
+    void buffer_view_bytes(int index, const std::string& what, const unsigned char*& bytes, std::size_t& size) const {
+        if (index < 0 || static_cast<std::size_t>(index) >= model.bufferViews.size())
+            fail(path, what + ": buffer view " + std::to_string(index) + " does not exist");
+        const tinygltf::BufferView& view = model.bufferViews[index];
+        if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size())
+            fail(path, what + ": buffer " + std::to_string(view.buffer) + " does not exist");
+        const std::vector<unsigned char>& buffer = model.buffers[view.buffer].data;
+        if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
+            fail(path, what + ": buffer view " + std::to_string(index) + " (offset " + std::to_string(view.byteOffset) +
+                           ", length " + std::to_string(view.byteLength) + ") lies outside its buffer of " +
+                           std::to_string(buffer.size()) + " bytes");
+        bytes = buffer.data() + view.byteOffset;
+        size = view.byteLength;
+    }
 
     bool material_blends(int material) const {
         return material >= 0 && static_cast<std::size_t>(material) < model.materials.size() &&
@@ -334,6 +659,40 @@ struct GltfLoader {
                 const double a = col.components() == 4 && blend ? col.get(i, 3) : 1.0;
                 mesh->colors[i] = glm::vec4(col.get(i, 0) * a, col.get(i, 1) * a, col.get(i, 2) * a, a);
             }
+        }
+
+        // Texture coordinates: float or normalized unsigned byte/short (glTF's uv convention is ours).
+        if (const auto uv_it = prim.attributes.find("TEXCOORD_0"); uv_it != prim.attributes.end()) {
+            const AccessorReader uv(model, uv_it->second, path, what + " TEXCOORD_0");
+            if (uv.components() != 2) fail(path, uv.what() + ": TEXCOORD_0 must be VEC2");
+            const int ct = uv.component_type();
+            if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+                !((ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
+                  uv.normalized()))
+                fail(path, uv.what() + ": TEXCOORD_0 must be float or normalized unsigned byte/short, got component type " +
+                               std::to_string(ct) + (uv.normalized() ? " (normalized)" : ""));
+            if (uv.count() != pos.count())
+                fail(path, uv.what() + ": TEXCOORD_0 has " + std::to_string(uv.count()) + " elements, POSITION " +
+                               std::to_string(pos.count()));
+            mesh->uvs.resize(uv.count());
+            for (std::size_t i = 0; i < uv.count(); ++i) mesh->uvs[i] = glm::vec2(uv.get(i, 0), uv.get(i, 1));
+        }
+
+        // Normals: float (or normalized signed byte/short, as KHR_mesh_quantization allows).
+        if (const auto n_it = prim.attributes.find("NORMAL"); n_it != prim.attributes.end()) {
+            const AccessorReader nrm(model, n_it->second, path, what + " NORMAL");
+            if (nrm.components() != 3) fail(path, nrm.what() + ": NORMAL must be VEC3");
+            const int ct = nrm.component_type();
+            if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+                !((ct == TINYGLTF_COMPONENT_TYPE_BYTE || ct == TINYGLTF_COMPONENT_TYPE_SHORT) && nrm.normalized()))
+                fail(path, nrm.what() + ": NORMAL must be float or normalized byte/short, got component type " +
+                               std::to_string(ct));
+            if (nrm.count() != pos.count())
+                fail(path, nrm.what() + ": NORMAL has " + std::to_string(nrm.count()) + " elements, POSITION " +
+                               std::to_string(pos.count()));
+            mesh->normals.resize(nrm.count());
+            for (std::size_t i = 0; i < nrm.count(); ++i)
+                mesh->normals[i] = glm::vec3(nrm.get(i, 0), nrm.get(i, 1), nrm.get(i, 2));
         }
 
         // Indices (any unsigned component type), or the vertices in order.
@@ -390,25 +749,7 @@ struct GltfLoader {
                 Draw draw;
                 draw.mesh = primitive_mesh(node.mesh, static_cast<int>(p)).get();
                 draw.model = world;
-                if (prim.material >= 0) {
-                    if (static_cast<std::size_t>(prim.material) >= model.materials.size())
-                        fail(path, "meshes[" + std::to_string(node.mesh) + "].primitives[" + std::to_string(p) +
-                                       "]: material " + std::to_string(prim.material) + " does not exist");
-                    const tinygltf::Material& mat = model.materials[prim.material];
-                    const std::vector<double>& f = mat.pbrMetallicRoughness.baseColorFactor;
-                    if (f.size() != 4) fail(path, "material '" + mat.name + "': baseColorFactor must have 4 numbers");
-                    for (double v : f)
-                        if (!std::isfinite(v)) fail(path, "material '" + mat.name + "': baseColorFactor is not finite");
-                    if (mat.alphaMode == "BLEND") {
-                        draw.color = glm::vec4(f[0] * f[3], f[1] * f[3], f[2] * f[3], f[3]);
-                        draw.state.blend = BlendMode::over;
-                    } else {
-                        draw.color = glm::vec4(f[0], f[1], f[2], 1.0);
-                    }
-                    if (!mat.doubleSided) draw.state.cull = CullMode::back;
-                } else {
-                    draw.state.cull = CullMode::back;  // the default material is single-sided
-                }
+                apply_material(draw, prim, node.mesh, static_cast<int>(p));
                 scene.draws.push_back(draw);
             }
         }
@@ -462,7 +803,8 @@ struct GltfLoader {
 
 LoadedScene load_gltf(const std::string& path, bool binary) {
     tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(skip_image, nullptr);
+    EmbeddedImages embedded;
+    loader.SetImageLoader(keep_data_uri_image, &embedded);
     tinygltf::Model model;
     std::string err, warn;
     bool ok = false;
@@ -474,8 +816,16 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
     }
     if (!ok) fail(path, "cannot read glTF: " + trim(err.empty() ? warn : err));
 
-    GltfLoader g(model, path);
-    add_warnings(g.scene.warnings, path, warn);
+    GltfLoader g(model, path, embedded);
+    // tinygltf's notes about external image files it could not read are dropped: images are
+    // loaded (or warned about, naming the material) by image_texture.
+    std::istringstream lines(warn);
+    std::string kept, line;
+    while (std::getline(lines, line))
+        if (line.rfind("File not found : ", 0) != 0 && line.rfind("File read error : ", 0) != 0 &&
+            line.rfind("File is empty : ", 0) != 0 && line.rfind("Failed to load external 'uri' for image[", 0) != 0)
+            kept += line + "\n";
+    add_warnings(g.scene.warnings, path, kept);
 
     // Roots: the default scene, else scene 0, else every node that is no other node's child.
     std::vector<int> roots;
@@ -497,9 +847,6 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
     if (g.skipped_primitives)
         g.scene.warnings.push_back(path + ": skipped " + std::to_string(g.skipped_primitives) +
                                    " primitive(s) whose mode is not TRIANGLES");
-    if (!model.textures.empty() || !model.images.empty())
-        g.scene.warnings.push_back(path + ": textures are not supported yet; " + std::to_string(model.textures.size()) +
-                                   " texture(s) ignored");
     return std::move(g.scene);
 }
 

@@ -2,6 +2,7 @@
 // Image files: PNG (sRGB 8-bit) and OpenEXR (linear float) output, and input from any format
 // OpenImageIO reads. This is the only part of mipraster that depends on OpenImageIO; its header
 // names no OpenImageIO type, so including it pulls in nothing from that library.
+#include <cstddef>
 #include <string>
 
 #include "mipraster/core/image.hpp"
@@ -32,5 +33,26 @@ void write_image(const std::string& path, const Image& image);
 /// decodes it as sRGB like any 8-bit file; store data images as EXR to read them back exactly.
 /// Throws std::runtime_error naming the path when the file is missing, unreadable or corrupt.
 Image read_image(const std::string& path);
+
+/// How read_image decodes a file (the defaults are read_image(path)'s).
+struct ImageReadOptions {
+    /// Integer-typed files: colour is sRGB-encoded (decoded with `srgb_to_linear`), else linear
+    /// data read as code / max code. Float files are linear whatever this says.
+    bool srgb = true;
+    /// Drop the alpha channel: every pixel gets alpha 1 and keeps its straight (un-premultiplied)
+    /// colour, for materials that ignore texture alpha (glTF OPAQUE/MASK, OBJ).
+    bool ignore_alpha = false;
+};
+
+/// read_image with decoding options. Also throws std::runtime_error for an image of more than
+/// 2^29 pixels (the largest texture).
+Image read_image(const std::string& path, const ImageReadOptions& options);
+
+/// Decodes an image file held in memory (e.g. embedded in a glTF file), like read_image. The
+/// format is recognized from the first bytes: PNG, JPEG, OpenEXR, WebP, GIF, BMP, TIFF or
+/// Radiance HDR. `name` identifies the image in messages. Throws std::runtime_error naming
+/// `name` for empty, unrecognized or corrupt bytes.
+Image read_image_from_memory(const void* bytes, std::size_t size, const std::string& name,
+                             const ImageReadOptions& options = {});
 
 }  // namespace mipraster

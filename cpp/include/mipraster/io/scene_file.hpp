@@ -3,11 +3,12 @@
 // meshes, draws and cameras. Part of mipraster_io, the one module that includes the file-format
 // libraries (tinyobjloader, tinygltf); this header names none of their types.
 //
-// What loads now: triangle geometry, vertex colours, the material's constant colour (OBJ Kd,
-// glTF baseColorFactor), glTF node transforms, alpha blending and face culling, and glTF cameras.
-// Texture references (OBJ map_Kd, glTF textures and images) and texture coordinates are skipped:
-// they are recorded nowhere until textures and samplers exist (the texture issue). Normals,
-// skins, morph targets and animations are ignored as well.
+// What loads now: triangle geometry, vertex colours, texture coordinates and normals, the
+// material's constant colour (OBJ Kd, glTF baseColorFactor) and base colour texture (OBJ map_Kd,
+// glTF baseColorTexture) with its sampler, glTF node transforms, alpha blending and face culling,
+// and glTF cameras. Image files are decoded by the io module (texture_file.hpp, OpenImageIO).
+// Other textures (normal, metallic-roughness, occlusion, emissive maps), skins, morph targets and
+// animations are ignored; normals are carried on the meshes but shading does not use them yet.
 #include <memory>
 #include <string>
 #include <vector>
@@ -58,22 +59,50 @@ struct LoadedScene {
 /// Loads a scene file, choosing the reader by extension (case-insensitive):
 ///  - `.obj` (+ its `mtllib` MTL files, looked up next to the OBJ): positions, faces (polygons
 ///    are triangulated), vertex colours of the `v x y z r g b` extension (linear; used only when
-///    every vertex has one), and one draw per material with color = Kd taken as linear RGB
-///    (faces without a material: white). Texture coordinates are parsed but unused; map_Kd is
-///    skipped. OBJ has no cameras.
-///  - `.gltf` (JSON with external or data-URI buffers) and `.glb` (binary): the default scene
-///    (else scene 0, else every root node); every node's mesh primitives of mode TRIANGLES
-///    (others are skipped with a warning) with any index component type, POSITION and COLOR_0
-///    (vec3/vec4; float or normalized unsigned byte/short, all linear; vec4 is premultiplied),
-///    drawn with the node's world matrix (matrix or TRS, composed down the hierarchy);
-///    material baseColorFactor as the draw colour (linear RGBA; alphaMode BLEND blends "over"
-///    with the colour premultiplied by its alpha, other modes are opaque: alpha 1); doubleSided
-///    false culls back faces. Cameras attached to nodes become NamedCameras in node order.
-///    Textures and images are skipped (image files are not even decoded).
+///    every vertex has one), texture coordinates (`vt`, with v flipped: v' = 1 − v, DESIGN.md §1)
+///    and normals (`vn`), and one draw per material with color = Kd taken as linear RGB (faces
+///    without a material: white). Vertices are split by their (position, vt, vn) index triple,
+///    so each mesh is compact and a position with two texture coordinates becomes two vertices;
+///    a mesh has uvs (normals) only when every face of its draw gives them. A material with
+///    `map_Kd` (the file relative to the OBJ's folder, `\` read as `/`) textures its faces with
+///    texture coordinates: draw.texture decoded as sRGB (`-colorspace linear`: linear), alpha
+///    ignored (OBJ draws are opaque), with the default sampler (trilinear, repeat; `-clamp on`:
+///    clamp); its `-s` scale and `-o` offset are applied to the uvs (uv·s + o, before the flip).
+///    Its faces without texture coordinates become a separate untextured draw, with a warning.
+///    OBJ has no cameras.
+///  - `.gltf` (JSON with external or data-URI buffers and images) and `.glb` (binary, images in
+///    bufferViews too): the default scene (else scene 0, else every root node); every node's
+///    mesh primitives of mode TRIANGLES (others are skipped with a warning) with any index
+///    component type, POSITION, COLOR_0 (vec3/vec4; float or normalized unsigned byte/short, all
+///    linear; vec4 is premultiplied), TEXCOORD_0 (vec2; float or normalized unsigned byte/short)
+///    as uvs and NORMAL (vec3; float or normalized byte/short) as normals, drawn with the node's
+///    world matrix (matrix or TRS, composed down the hierarchy); material baseColorFactor as the
+///    draw colour (linear RGBA; alphaMode BLEND blends "over" with the colour premultiplied by its
+///    alpha, other modes are opaque: alpha 1); doubleSided false culls back faces. The material's
+///    pbrMetallicRoughness.baseColorTexture becomes draw.texture: its image decoded from sRGB
+///    into linear premultiplied RGBA (external files relative to the .gltf, percent-decoded;
+///    data URIs and bufferViews from memory), its alpha ignored unless the material blends; the
+///    texture's sampler becomes draw.sampler: wrapS/wrapT 10497 REPEAT → repeat, 33071
+///    CLAMP_TO_EDGE → clamp, 33648 MIRRORED_REPEAT → mirror; magFilter 9728 NEAREST / 9729
+///    LINEAR → mag_filter; minFilter 9728 / 9729 → min_filter nearest / linear with mip_filter
+///    none, 9984 NEAREST_MIPMAP_NEAREST, 9985 LINEAR_MIPMAP_NEAREST, 9986 NEAREST_MIPMAP_LINEAR,
+///    9987 LINEAR_MIPMAP_LINEAR → (min_filter, mip_filter) = (nearest, nearest), (linear,
+///    nearest), (nearest, linear), (linear, linear); undefined filters keep the library default
+///    (trilinear), the footprint is isotropic, and values that are no glTF enum are warned about
+///    and replaced by the defaults. A baseColorTexture on another texCoord than 0, on a primitive
+///    without TEXCOORD_0, or whose texture has no source image is skipped with a warning (the
+///    draw is untextured); KHR_texture_transform is ignored with a warning. Cameras attached to
+///    nodes become NamedCameras in node order.
+/// A texture file that is missing, unreadable or corrupt does not stop the load: the draw gets
+/// error_texture() (an 8×8 magenta/black checker) and a warning naming the material and the
+/// file. Images are shared through the texture cache (load_texture), so loading the same files
+/// again reuses their textures.
 /// Throws std::invalid_argument naming the path and the supported extensions for another
 /// extension, and std::runtime_error (or std::invalid_argument from Mesh::validate) whose
 /// message names the file and the problem for a missing, truncated or corrupt file, an
-/// accessor outside its buffer, an index out of range, a node cycle or absurd counts.
+/// accessor outside its buffer or of the wrong type or count (e.g. TEXCOORD_0 that is not VEC2),
+/// an index out of range (vertex, texture coordinate, normal, material, texture, sampler,
+/// image source), an image bufferView outside its buffer, a node cycle or absurd counts.
 LoadedScene load_scene(const std::string& path);
 
 /// World-space axis-aligned bounds of the draws' vertices (model matrices applied). Returns
