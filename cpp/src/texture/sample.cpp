@@ -37,6 +37,7 @@ double centre(double x, int n, double extent, WrapMode mode) {
 
 // Index along one axis after wrapping; −1 for the border. |i| stays within a few periods.
 int wrap_index(int i, int n, WrapMode mode) {
+    if (static_cast<unsigned>(i) < static_cast<unsigned>(n)) return i;  // inside: every mode agrees
     switch (mode) {
         case WrapMode::repeat: i %= n; return i < 0 ? i + n : i;
         case WrapMode::mirror: {
@@ -97,8 +98,10 @@ glm::dvec4 texel_filter(const TextureLevel& level, double u, double v, TexelFilt
 struct Footprint {
     double ux, vx, uy, vy;  // ∂(u·w, v·h)/∂x and /∂y
     bool finite() const { return std::isfinite(ux) && std::isfinite(vx) && std::isfinite(uy) && std::isfinite(vy); }
-    double length_x() const { return std::hypot(ux, vx); }
-    double length_y() const { return std::hypot(uy, vy); }
+    // Plain sqrt of the sum of squares (hypot is much slower): a length past ~1e154 overflows to
+    // inf, which selects the coarsest level as the true length would.
+    double length_x() const { return std::sqrt(ux * ux + vx * vx); }
+    double length_y() const { return std::sqrt(uy * uy + vy * vy); }
 };
 
 Footprint texel_footprint(const TextureView& t, glm::vec2 dx, glm::vec2 dy) {
@@ -312,6 +315,8 @@ double texture_lod(const TextureView& t, const Sampler& s, glm::vec2 dx, glm::ve
 glm::vec4 sample_texture(const TextureView& t, const Sampler& s, glm::vec2 uv, glm::vec2 dx, glm::vec2 dy) {
     if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return s.border_color;
     const double u = uv.x, v = uv.y;
+    // One filter on level 0 whatever λ is: no need to compute it.
+    if (!s.needs_derivatives()) return glm::vec4(texel_filter(t.level(0), u, v, s.mag_filter, s));
     const Footprint f = texel_footprint(t, dx, dy);
     switch (s.footprint) {
         case FootprintFilter::isotropic: return glm::vec4(isotropic(t, u, v, isotropic_lod(f, s, t.level_count()), s));
