@@ -71,6 +71,60 @@ class Mesh:
         self._mesh = _core.Mesh(pos32, tri32, col32, uv32, nrm32)
 
     @classmethod
+    def from_trimesh(cls, mesh: Any, colors: bool = True) -> "Mesh":
+        """A Mesh from a ``trimesh.Trimesh`` (or any object with ``.vertices`` and ``.faces``).
+
+        Takes the vertex positions, the faces and ``mesh.vertex_normals``; texture coordinates
+        from ``mesh.visual.uv`` when the visual has them (a ``TextureVisuals``), with v flipped
+        (``v' = 1 − v``: trimesh and OBJ have v growing upwards from the image's bottom row,
+        mipraster's (0, 0) is its top-left corner); and, when ``colors`` is true and the visual is
+        a ``ColorVisuals`` holding vertex or face colours (``visual.kind`` ``"vertex"`` or
+        ``"face"``), ``visual.vertex_colors`` — 8-bit sRGB RGBA with straight alpha (floats are
+        taken as sRGB in [0, 1]) — decoded to linear premultiplied RGBA with
+        :func:`mipraster.srgb_to_linear`. Face colours are averaged onto the vertices by trimesh;
+        call ``mesh.unmerge_vertices()`` first to keep them exact. Textures and materials are not
+        converted. A ``trimesh.Scene`` is flattened into one mesh (``Scene.to_geometry()``).
+
+        Duck-typed objects need ``vertices`` and ``faces``; ``vertex_normals`` and ``visual``
+        (with ``uv`` and/or ``kind`` + ``vertex_colors``) are optional. trimesh itself is only
+        imported for other objects (to recognize a Scene), never by ``import mipraster``.
+
+        Raises:
+            ImportError: ``mesh`` has no ``vertices`` and ``faces`` and trimesh is not installed.
+            TypeError: ``mesh`` is neither a mesh nor a Scene.
+            ValueError / TypeError: as :class:`Mesh` for the arrays (e.g. NaN positions, naming
+                the array).
+        """
+        want_colors = _checks.flag(colors, "colors")
+        if not (hasattr(mesh, "vertices") and hasattr(mesh, "faces")):
+            try:
+                import trimesh
+            except ImportError:
+                raise ImportError(
+                    f"Mesh.from_trimesh: got a {type(mesh).__name__}, not an object with .vertices and .faces; "
+                    "reading trimesh objects needs the trimesh package: pip install trimesh"
+                ) from None
+            if not isinstance(mesh, trimesh.Scene):
+                raise TypeError(f"mesh: expected a trimesh.Trimesh, a trimesh.Scene or an object with .vertices and "
+                                f".faces, got {type(mesh).__name__}")
+            mesh = mesh.to_geometry() if hasattr(mesh, "to_geometry") else mesh.dump(concatenate=True)
+
+        positions = np.asarray(mesh.vertices)
+        normals = getattr(mesh, "vertex_normals", None)
+        visual = getattr(mesh, "visual", None)
+        uvs = getattr(visual, "uv", None)
+        if uvs is not None:
+            uvs = _checks.real_array(uvs, "uvs").astype(np.float64)
+            _checks.check_shape(uvs, "uvs", (None, 2))
+            uvs = np.stack([uvs[:, 0], 1.0 - uvs[:, 1]], axis=1)
+        col = None
+        if want_colors and getattr(visual, "kind", None) in ("vertex", "face"):
+            rgba = getattr(visual, "vertex_colors", None)
+            if rgba is not None:
+                col = _srgb8_to_linear_premultiplied(rgba)
+        return cls(positions, mesh.faces, colors=col, uvs=uvs, normals=normals)
+
+    @classmethod
     def _from_core(cls, mesh: _core.Mesh) -> "Mesh":
         """Wraps an existing C++ mesh (e.g. the demo's) without copying or re-checking it."""
         self = cls.__new__(cls)
@@ -123,6 +177,21 @@ def _per_vertex(values: Any, name: str, n: int, columns: int) -> np.ndarray:
     _checks.check_shape(a, name, (n, columns))
     _checks.check_finite(a, name)
     return _checks.to_float32(a, name)
+
+
+def _srgb8_to_linear_premultiplied(rgba: Any) -> np.ndarray:
+    """``(N, 3)`` / ``(N, 4)`` sRGB colours with straight alpha — integer codes 0…255 or floats in
+    [0, 1] — as ``(N, 4)`` float64 linear premultiplied RGBA."""
+    a = _checks.empty_rows(_checks.real_array(rgba, "vertex_colors"), 4)
+    _checks.check_shape(a, "vertex_colors", (None, 3), (None, 4))
+    _checks.check_finite(a, "vertex_colors")
+    if a.dtype.kind in "iu" and a.size and (a.min() < 0 or a.max() > 255):
+        r, c = (int(i) for i in np.argwhere((a < 0) | (a > 255))[0])
+        raise ValueError(f"vertex_colors[{r}, {c}] = {int(a[r, c])}: expected 8-bit codes 0 to 255")
+    a = a.astype(np.float64) / 255.0 if a.dtype.kind in "iu" else a.astype(np.float64)
+    alpha = a[:, 3:4] if a.shape[1] == 4 else np.ones((a.shape[0], 1))
+    linear = np.asarray(_core.srgb_to_linear(np.ascontiguousarray(a[:, :3])), dtype=np.float64)
+    return np.concatenate([linear * alpha, alpha], axis=1)
 
 
 def _check_indices(tri: np.ndarray, n: int) -> None:

@@ -2,15 +2,17 @@
 
 :func:`rasterize` clips and rasterizes clip-space triangles (watertight, top-left rule, depth
 test) and returns, for every sample, which triangle covers it and where; :func:`interpolate`
-turns that into per-sample vertex attributes; :func:`resolve` averages samples into pixels::
+turns that into per-sample vertex attributes (and, on request, their analytic screen-space
+derivatives); :func:`resolve` averages samples into pixels::
 
     raster = mr.rasterize(pos_clip, triangles, 256, 256, spp=4)
     uv = mr.interpolate(uvs, raster, triangles)            # (256, 256, 4, 2)
     image = mr.resolve(shade(uv))                          # (256, 256, C)
+    uv, duv_dx, duv_dy = mr.interpolate(uvs, raster, triangles, derivatives=True)
 """
 from __future__ import annotations
 
-from typing import Any, Dict, Union
+from typing import Any, Dict, Literal, Tuple, Union, overload
 
 import numpy as np
 
@@ -39,19 +41,23 @@ class Raster:
         pattern: ``(S, 2)`` float64 sample offsets from the pixel's top-left corner, in pixels.
         pattern_kind: the sample pattern used.
         stats: dict of counters and times, as :attr:`RenderResult.stats`.
-        w: ``(N,)`` float64 clip-space w of the vertices (what ``interpolate(mode="screen")`` needs).
+        pos_clip: ``(N, 4)`` float64 copy of the clip-space vertex positions given to
+            :func:`rasterize` (what ``interpolate(derivatives=True)`` needs).
+        w: ``(N,)`` float64 clip-space w of the vertices (a view of ``pos_clip[:, 3]``; what
+            ``interpolate(mode="screen")`` needs).
     """
 
-    __slots__ = ("triangle_id", "barycentrics", "depth", "pattern", "pattern_kind", "stats", "w")
+    __slots__ = ("triangle_id", "barycentrics", "depth", "pattern", "pattern_kind", "stats", "pos_clip", "w")
 
-    def __init__(self, raw: Dict[str, Any], w: np.ndarray) -> None:
+    def __init__(self, raw: Dict[str, Any], pos_clip: np.ndarray) -> None:
         self.triangle_id: np.ndarray = raw["triangle_id"]
         self.barycentrics: np.ndarray = raw["barycentrics"]
         self.depth: np.ndarray = raw["depth"]
         self.pattern: np.ndarray = raw["pattern"]
         self.pattern_kind: str = raw["pattern_kind"]
         self.stats: Dict[str, Union[int, float]] = raw["stats"]
-        self.w: np.ndarray = w
+        self.pos_clip: np.ndarray = pos_clip
+        self.w: np.ndarray = pos_clip[:, 3]
 
     def __repr__(self) -> str:
         h, w, s = self.triangle_id.shape
@@ -107,11 +113,32 @@ def rasterize(pos_clip: Any, triangles: Any, width: int, height: int, spp: int =
     settings.threads = _int_in(threads, "threads", _INT32_MIN, _INT32_MAX, f"0 (all cores) to {_core.MAX_THREADS}")
     settings.depth_convention = _checks.choice(depth, "depth", DEPTH_CONVENTIONS)
     settings.cull = _checks.choice(cull, "cull", CULL_MODES)
-    return Raster(_core.rasterize(pos, tri, settings), pos[:, 3].copy())
+    return Raster(_core.rasterize(pos, tri, settings), pos.copy())  # pos may be the caller's array
 
 
-def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str = "perspective") -> np.ndarray:
-    """Vertex attributes at every sample of ``raster``.
+@overload
+def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str = ...,
+                derivatives: Literal[False] = ...) -> np.ndarray: ...
+
+
+@overload
+def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str,
+                derivatives: Literal[True]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
+@overload
+def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str = ..., *,
+                derivatives: Literal[True]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
+@overload
+def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str = ...,
+                derivatives: bool = ...) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray, np.ndarray]]: ...
+
+
+def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str = "perspective",
+                derivatives: bool = False) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Vertex attributes at every sample of ``raster``, and optionally their screen-space derivatives.
 
     Args:
         attributes: ``(N, K)`` (or ``(N,)``) per-vertex values, any real dtype.
@@ -120,10 +147,17 @@ def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str = "pe
         mode: ``"perspective"`` (perspective-correct, the default), ``"screen"`` (affine in screen
             space, the seeds' "perspective-incorrect" interpolation) or ``"flat"`` (the value of each
             triangle's first vertex).
+        derivatives: also return the analytic derivatives of the interpolated values with respect
+            to screen position, per pixel: ``d_dx`` one pixel to the right, ``d_dy`` one pixel down
+            (row 0 is the top row). They are exact derivatives of the interpolation function of the
+            submitted (unclipped, unsnapped) triangle at each sample's position (pixel corner +
+            :attr:`Raster.pattern` offset), computed in clip space so that triangles crossing the
+            near plane need no special care; 0 for ``"flat"``.
 
     Returns:
         ``(H, W, S, K)`` float32 (``(H, W, S)`` for 1-D attributes); 0 where no triangle covers
-        the sample.
+        the sample. With ``derivatives=True``, the tuple ``(values, d_dx, d_dy)`` of three such
+        arrays.
     """
     if not isinstance(raster, Raster):
         raise TypeError(f"raster: expected a mipraster.Raster (from rasterize), got {type(raster).__name__}")
@@ -135,6 +169,7 @@ def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str = "pe
     _checks.check_finite(attr, "attributes")
     tri = _triangles(triangles, raster.w.shape[0])
     mode = _checks.choice(mode, "mode", {m: m for m in INTERPOLATION_MODES})
+    want_derivatives = _checks.flag(derivatives, "derivatives")
     ids = raster.triangle_id
     if ids.size and ids.max() >= tri.shape[0]:
         raise ValueError(f"triangles: the raster refers to triangle {int(ids.max())} but only {tri.shape[0]} were "
@@ -152,9 +187,57 @@ def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str = "pe
             weights = weights * raster.w[corners]
             weights /= weights.sum(axis=1, keepdims=True)
         result = np.einsum("mi,mik->mk", weights, values)
-    out = np.zeros(ids.shape + (attr.shape[1],), dtype=np.float32)
-    out[covered] = result
-    return out[..., 0] if one_d else out
+
+    def scatter(per_sample: np.ndarray) -> np.ndarray:
+        out = np.zeros(ids.shape + (attr.shape[1],), dtype=np.float32)
+        out[covered] = per_sample
+        return out[..., 0] if one_d else out
+
+    if not want_derivatives:
+        return scatter(result)
+    if mode == "flat":
+        zeros = np.zeros_like(result)
+        return scatter(result), scatter(zeros), scatter(zeros)
+    d_dx, d_dy = _screen_derivatives(raster, covered, corners, values, mode)
+    return scatter(result), scatter(d_dx), scatter(d_dy)
+
+
+def _screen_derivatives(raster: Raster, covered: np.ndarray, corners: np.ndarray, values: np.ndarray,
+                        mode: str) -> Tuple[np.ndarray, np.ndarray]:
+    """``(M, K)`` derivatives per pixel (x right, y down) of the interpolated ``values`` ``(M, 3, K)``.
+
+    With the vertices as 2D homogeneous points v_i = (x_i, y_i, w_i) (clip x, y, w) and the sample's
+    NDC position p = (X, Y, 1), e_i = (v_j × v_k) · p ((i, j, k) cyclic) is proportional to the
+    perspective-correct weight of vertex i (e_i = β_i det(v_0, v_1, v_2) / w at the sample), so
+    b_i = e_i / Σe. This holds for any signs of the w_i, so clipped triangles need nothing special.
+    Screen-space weights are λ_i = b_i w_i / Σ b_j w_j = e_i w_i / Σ e_j w_j. Both are q_i / Σq
+    with q linear in (X, Y): ∂(q_i / Σq) = (∂q_i − (q_i / Σq) Σ∂q) / Σq.
+    """
+    h, w, _ = covered.shape
+    rows, cols, samples = np.nonzero(covered)
+    offsets = raster.pattern[samples]  # (M, 2) from the pixel's top-left corner
+    ndc_x = (cols + offsets[:, 0]) * (2.0 / w) - 1.0
+    ndc_y = 1.0 - (rows + offsets[:, 1]) * (2.0 / h)
+
+    v = raster.pos_clip[corners][:, :, [0, 1, 3]]  # (M, 3 vertices, (x, y, w))
+    planes = np.cross(v[:, [1, 2, 0]], v[:, [2, 0, 1]])  # (M, 3, 3): row i = v_j × v_k = (A_i, B_i, C_i)
+    q = planes[:, :, 0] * ndc_x[:, None] + planes[:, :, 1] * ndc_y[:, None] + planes[:, :, 2]  # (M, 3)
+    q_x, q_y = planes[:, :, 0], planes[:, :, 1]
+    if mode == "screen":
+        q, q_x, q_y = q * v[:, :, 2], q_x * v[:, :, 2], q_y * v[:, :, 2]
+    total = q.sum(axis=1, keepdims=True)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        weights = q / total
+        d_dX = (q_x - weights * q_x.sum(axis=1, keepdims=True)) / total  # (M, 3) ∂weight_i / ∂X
+        d_dY = (q_y - weights * q_y.sum(axis=1, keepdims=True)) / total
+        # NDC → pixels: X = 2x/W − 1, Y = 1 − 2y/H.
+        d_dx = np.einsum("mi,mik->mk", d_dX, values) * (2.0 / w)
+        d_dy = np.einsum("mi,mik->mk", d_dY, values) * (-2.0 / h)
+    # A covered sample has Σq ≠ 0 (its triangle has area and the sample lies in front of the eye);
+    # should rounding say otherwise, report 0 rather than let a NaN or Inf through.
+    d_dx[~np.isfinite(d_dx)] = 0.0
+    d_dy[~np.isfinite(d_dy)] = 0.0
+    return d_dx, d_dy
 
 
 def resolve(samples: Any, filter: str = "box") -> np.ndarray:

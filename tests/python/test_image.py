@@ -50,6 +50,76 @@ def test_read_png_decodes_srgb_to_linear(tmp_path):
     np.testing.assert_array_equal(back[..., 3], 1.0)
 
 
+def srgb_decode(codes):
+    """IEC 61966-2-1 sRGB decoding of 8-bit codes, written out here as the oracle."""
+    c = np.asarray(codes, dtype=np.float64) / 255.0
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+@pytest.mark.parametrize("mode", ["RGB", "L"])
+def test_read_jpeg_decodes_srgb_to_linear(tmp_path, mode):
+    # A flat colour survives JPEG's lossy coding within a code or two.
+    code = (188, 60, 230) if mode == "RGB" else 188
+    Image.new(mode, (16, 8), code).save(tmp_path / "flat.jpg", quality=95, subsampling=0)
+    back = mr.read_image(tmp_path / "flat.jpg")
+    assert back.shape == (8, 16, 4) and back.dtype == np.float32
+    codes = np.broadcast_to(np.atleast_1d(code), (3,))
+    lo, hi = srgb_decode(np.maximum(codes - 2, 0)), srgb_decode(np.minimum(codes + 2, 255))
+    assert ((back[..., :3] >= lo) & (back[..., :3] <= hi)).all(), (back[0, 0], srgb_decode(codes))
+    np.testing.assert_array_equal(back[..., 3], 1.0)
+
+
+@pytest.mark.parametrize("compression", [None, "tga_rle"])
+def test_read_tga_with_alpha_gives_premultiplied_linear_colour(tmp_path, compression):
+    rng = np.random.default_rng(11)
+    rgba8 = rng.integers(0, 256, (5, 7, 4), dtype=np.uint8)
+    rgba8[0, 0] = [200, 100, 50, 0]  # fully transparent: premultiplied to 0
+    rgba8[0, 1] = [188, 188, 188, 255]
+    path = tmp_path / "x.tga"
+    Image.fromarray(rgba8, "RGBA").save(path, compression=compression)
+    back = mr.read_image(path)
+    assert back.shape == (5, 7, 4)  # rows in file order, top row first
+    alpha = rgba8[..., 3:4] / 255.0
+    np.testing.assert_allclose(back[..., :3], srgb_decode(rgba8[..., :3]) * alpha, rtol=1e-5, atol=1e-7)
+    np.testing.assert_allclose(back[..., 3:], alpha, rtol=1e-6)
+    np.testing.assert_array_equal(back[0, 0], 0.0)
+    # Without alpha: opaque, and the same sRGB decoding.
+    Image.fromarray(rgba8[..., :3], "RGB").save(tmp_path / "rgb.tga", compression=compression)
+    rgb = mr.read_image(tmp_path / "rgb.tga")
+    np.testing.assert_allclose(rgb[..., :3], srgb_decode(rgba8[..., :3]), rtol=1e-5, atol=1e-7)
+    np.testing.assert_array_equal(rgb[..., 3], 1.0)
+
+
+def write_radiance_hdr(path, rgb):
+    """A Radiance RGBE file with flat (uncompressed) scanlines, as allowed for widths below 8."""
+    h, w, _ = rgb.shape
+    assert w < 8
+    m = rgb.max(axis=-1)
+    mantissa, exponent = np.frexp(m)  # m = mantissa · 2^exponent, mantissa in [0.5, 1)
+    scale = np.where(m > 0, 256.0 / np.ldexp(1.0, exponent), 0.0)
+    rgbe = np.zeros((h, w, 4), np.uint8)
+    rgbe[..., :3] = np.floor(rgb * scale[..., None])
+    rgbe[..., 3] = np.where(m > 0, exponent + 128, 0)
+    header = f"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {w}\n".encode("ascii")
+    path.write_bytes(header + rgbe.tobytes())
+
+
+def test_read_radiance_hdr_returns_linear_values_as_written(tmp_path):
+    rng = np.random.default_rng(12)
+    rgb = rng.uniform(0.0, 1.0, (3, 5, 3)) * rng.choice([0.01, 1.0, 40.0], (3, 5, 1))  # beyond 1 too
+    rgb[0, 0] = [0.0, 0.0, 0.0]
+    rgb[0, 1] = [3.7, 0.25, 120.0]
+    write_radiance_hdr(tmp_path / "x.hdr", rgb)
+    back = mr.read_image(tmp_path / "x.hdr")
+    assert back.shape == (3, 5, 4) and back.dtype == np.float32
+    # RGBE keeps 8 bits of mantissa below a shared exponent: errors up to ~1% of the largest channel.
+    tolerance = 0.01 * rgb.max(axis=-1, keepdims=True)
+    assert (np.abs(back[..., :3] - rgb) <= tolerance).all(), np.abs(back[..., :3] - rgb).max()
+    np.testing.assert_array_equal(back[0, 0], [0, 0, 0, 1])
+    np.testing.assert_array_equal(back[..., 3], 1.0)
+    assert back[0, 1, 2] > 100  # not clamped, not sRGB-decoded
+
+
 def test_write_image_accepts_float64_grey_and_rgb(tmp_path):
     mr.write_image(tmp_path / "grey.png", np.full((2, 3), 0.5))  # data: plain grey, no sRGB
     assert np.all(np.asarray(Image.open(tmp_path / "grey.png")) == 128)

@@ -190,3 +190,218 @@ def test_render_depth_is_view_distance_of_the_nearest_surface_and_inf_where_empt
     no_test = mr.Scene()
     no_test.add(quad, depth_test=False)
     assert mr.render(no_test, cam, 8, 8).depth is None
+
+
+# --- interpolate(derivatives=True) ------------------------------------------------------------------
+# Oracles: a double-precision ray cast against the world-space triangle (perspective mode) and 2D
+# barycentrics of the projected vertices (screen mode), differentiated by central finite differences
+# at the samples' own positions. Neither uses the clip-space plane formula of the implementation.
+
+FD_STEP_PX = 1e-3
+
+
+def perspective_matrix(fov_y_deg, aspect, near, far):
+    f = 1.0 / np.tan(np.radians(fov_y_deg) / 2)
+    return np.array([[f / aspect, 0, 0, 0], [0, f, 0, 0],
+                     [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)], [0, 0, -1, 0]])
+
+
+def random_rotation(rng):
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    q *= np.sign(np.diag(r))
+    return q if np.linalg.det(q) > 0 else -q
+
+
+def perspective_scene(rng, view_vertices, width, height):
+    """World-space triangles seen by a randomly placed camera, and their clip-space positions.
+    `view_vertices` (T, 3, 3) are camera-space positions (camera at the origin looking down −z)."""
+    view = np.eye(4)
+    view[:3, :3] = random_rotation(rng)
+    view[:3, 3] = rng.uniform(-3, 3, 3)
+    proj = perspective_matrix(rng.uniform(40, 80), width / height, 0.1, 100.0)
+    vv = view_vertices.reshape(-1, 3)
+    world = (np.linalg.inv(view) @ np.c_[vv, np.ones(len(vv))].T).T[:, :3]
+    pos_clip = (proj @ view @ np.c_[world, np.ones(len(world))].T).T
+    tris = np.arange(len(vv)).reshape(-1, 3)
+    return world, pos_clip, tris, np.linalg.inv(proj @ view)
+
+
+def ray_cast(world, tris, inv_view_proj, width, height, ids, px, py, attr):
+    """Perspective-correct attribute at screen points (px, py) of triangles `ids`: intersect the
+    eye ray with the world-space triangle's plane and take area ratios there."""
+    ndc = np.stack([2 * px / width - 1, 1 - 2 * py / height], axis=-1)
+    ends = []
+    for z in (-1.0, 1.0):
+        h = np.c_[ndc, np.full(len(px), z), np.ones(len(px))] @ inv_view_proj.T
+        ends.append(h[:, :3] / h[:, 3:4])
+    origin, direction = ends[0], ends[1] - ends[0]
+    a, b, c = (world[tris[ids, k]] for k in range(3))
+    n = np.cross(b - a, c - a)
+    t = np.einsum("mi,mi->m", n, a - origin) / np.einsum("mi,mi->m", n, direction)
+    hit = origin + t[:, None] * direction
+    nn = np.einsum("mi,mi->m", n, n)
+    w0 = np.einsum("mi,mi->m", n, np.cross(b - hit, c - hit)) / nn
+    w1 = np.einsum("mi,mi->m", n, np.cross(c - hit, a - hit)) / nn
+    weights = np.stack([w0, w1, 1 - w0 - w1], axis=1)
+    return np.einsum("mi,mik->mk", weights, attr[tris[ids]])
+
+
+def screen_affine(pos_clip, tris, width, height, ids, px, py, attr):
+    """Screen-space (affine) attribute: 2D barycentrics of (px, py) in the projected triangle."""
+    s = to_screen(pos_clip[:, :2] / pos_clip[:, 3:4], width, height)[tris[ids]]  # (M, 3, 2)
+    p = np.stack([px, py], axis=-1)
+
+    def cross2(u, v):
+        return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+
+    area = cross2(s[:, 1] - s[:, 0], s[:, 2] - s[:, 0])
+    weights = np.stack([cross2(s[:, (i + 1) % 3] - p, s[:, (i + 2) % 3] - p) / area for i in range(3)], axis=1)
+    return np.einsum("mi,mik->mk", weights, attr[tris[ids]])
+
+
+def check_derivatives_against(oracle, raster, tris, attr, mode, rng, n_points=400):
+    """interpolate(derivatives=True) at random covered samples vs central differences of `oracle`."""
+    H, W, S = raster.triangle_id.shape
+    values, d_dx, d_dy = mr.interpolate(attr, raster, tris, mode=mode, derivatives=True)
+    k = 1 if attr.ndim == 1 else attr.shape[1]
+    for a in (values, d_dx, d_dy):
+        assert a.dtype == np.float32 and a.shape == (H, W, S) + (() if attr.ndim == 1 else (k,))
+    covered = raster.triangle_id >= 0
+    assert covered.sum() > 100
+    rows, cols, samples = np.nonzero(covered)
+    pick = rng.choice(len(rows), size=min(n_points, len(rows)), replace=False)
+    rows, cols, samples = rows[pick], cols[pick], samples[pick]
+    ids = raster.triangle_id[rows, cols, samples]
+    px = cols + raster.pattern[samples, 0]
+    py = rows + raster.pattern[samples, 1]
+    a2 = attr.reshape(attr.shape[0], -1).astype(np.float64)
+
+    def f(x, y):
+        return oracle(ids, x, y, a2)
+
+    h = FD_STEP_PX
+    fd_x = (f(px + h, py) - f(px - h, py)) / (2 * h)
+    fd_y = (f(px, py + h) - f(px, py - h)) / (2 * h)
+    got_x = d_dx[rows, cols, samples].reshape(len(pick), -1)
+    got_y = d_dy[rows, cols, samples].reshape(len(pick), -1)
+    scale = max(np.abs(fd_x).max(), np.abs(fd_y).max())
+    np.testing.assert_allclose(got_x, fd_x, rtol=1e-5, atol=1e-6 * scale)
+    np.testing.assert_allclose(got_y, fd_y, rtol=1e-5, atol=1e-6 * scale)
+    # The values themselves come from the (snapped) raster: equal to the oracle within the snap band.
+    got = values[rows, cols, samples].reshape(len(pick), -1)
+    slack = (np.abs(fd_x) + np.abs(fd_y)) * SNAP_PX * 1.5 + 1e-5 * np.abs(f(px, py)).max() + 1e-6
+    assert (np.abs(got - f(px, py)) <= slack).all()
+    return fd_x, fd_y
+
+
+def random_view_triangles(rng, n):
+    """Camera-space triangles in front of the camera with strongly varying depth."""
+    centre_z = rng.uniform(-8.0, -1.5, (n, 1, 1))
+    z = centre_z + rng.uniform(-1.2, 1.2, (n, 3, 1))
+    z = np.minimum(z, -0.5)
+    xy = rng.uniform(-0.6, 0.6, (n, 1, 2)) * -centre_z + rng.uniform(-0.5, 0.5, (n, 3, 2)) * -z
+    return np.concatenate([xy, z], axis=-1)
+
+
+@pytest.mark.parametrize("spp, pattern", [(1, "center"), (4, "stratified"), (16, "stratified")])
+@pytest.mark.parametrize("k", [1, 3])
+def test_perspective_derivatives_match_finite_differences_of_a_ray_cast(spp, pattern, k):
+    W, H = 64, 48
+    rng = np.random.default_rng(100 + spp + k)
+    world, pos, tris, inv_vp = perspective_scene(rng, random_view_triangles(rng, 12), W, H)
+    assert np.ptp(pos[:, 3]) > 2.0  # w varies: the interpolation is far from affine
+    raster = mr.rasterize(pos, tris, W, H, spp=spp, pattern=pattern, seed=spp)
+    attr = rng.uniform(-2, 2, (len(pos), k))
+    attr = attr[:, 0] if k == 1 else attr
+    fd_x, fd_y = check_derivatives_against(
+        lambda ids, x, y, a: ray_cast(world, tris, inv_vp, W, H, ids, x, y, a), raster, tris, attr, "perspective", rng)
+    assert np.abs(fd_x).max() > 1e-2 and np.abs(fd_y).max() > 1e-2  # the test measures something
+
+
+@pytest.mark.parametrize("k", [1, 2])
+def test_screen_derivatives_match_finite_differences_of_screen_barycentrics(k):
+    W, H = 64, 48
+    rng = np.random.default_rng(200 + k)
+    world, pos, tris, inv_vp = perspective_scene(rng, random_view_triangles(rng, 12), W, H)
+    raster = mr.rasterize(pos, tris, W, H, spp=4, pattern="stratified")
+    attr = rng.uniform(-2, 2, (len(pos), k))
+    attr = attr[:, 0] if k == 1 else attr
+    check_derivatives_against(lambda ids, x, y, a: screen_affine(pos, tris, W, H, ids, x, y, a),
+                              raster, tris, attr, "screen", rng)
+    # Screen-space interpolation is affine on screen: its derivatives are constant per triangle,
+    # and they differ from the perspective-correct ones.
+    _, sx, sy = mr.interpolate(attr, raster, tris, mode="screen", derivatives=True)
+    _, px_, py_ = mr.interpolate(attr, raster, tris, derivatives=True)
+    ids = raster.triangle_id
+    for t in np.unique(ids[ids >= 0]):
+        vals = sx[ids == t]
+        np.testing.assert_allclose(vals, np.broadcast_to(vals[0], vals.shape), rtol=1e-5, atol=1e-7)
+    assert np.abs(px_ - sx).max() > 1e-2 or np.abs(py_ - sy).max() > 1e-2
+
+
+@pytest.mark.parametrize("mode", ["perspective", "screen"])
+def test_derivatives_of_a_triangle_crossing_the_near_plane(mode):
+    W, H = 48, 40
+    rng = np.random.default_rng(300)
+    # One vertex behind the camera (camera-space z > 0, so clip w < 0): rasterize clips the triangle.
+    view_tri = np.array([[[-1.0, -0.8, -2.0], [1.2, -0.5, -3.0], [0.2, 0.4, 1.0]]])
+    world, pos, tris, inv_vp = perspective_scene(rng, view_tri, W, H)
+    assert pos[2, 3] < 0 < min(pos[0, 3], pos[1, 3])
+    raster = mr.rasterize(pos, tris, W, H, spp=4, pattern="stratified")
+    assert raster.stats["triangles_clipped"] == 1
+    attr = rng.uniform(-1, 1, (3, 3))
+    if mode == "perspective":
+        oracle = lambda ids, x, y, a: ray_cast(world, tris, inv_vp, W, H, ids, x, y, a)  # noqa: E731
+    else:
+        oracle = lambda ids, x, y, a: screen_affine(pos, tris, W, H, ids, x, y, a)  # noqa: E731
+    check_derivatives_against(oracle, raster, tris, attr, mode, rng)
+    _, d_dx, d_dy = mr.interpolate(attr, raster, tris, mode=mode, derivatives=True)
+    assert np.isfinite(d_dx).all() and np.isfinite(d_dy).all()
+
+
+def test_derivatives_of_an_affine_ramp_are_its_slope_in_pixels():
+    # w = 1 everywhere: NDC x grows by 2/W per pixel to the right, NDC y by −2/H per pixel down.
+    W, H = 16, 10
+    pos = np.array([[-1, -1, 0, 1], [3, -1, 0, 1], [-1, 3, 0, 1]], dtype=np.float64)
+    tris = [[0, 1, 2]]
+    raster = mr.rasterize(pos, tris, W, H, spp=4)
+    assert (raster.triangle_id == 0).all()
+    for mode in ("perspective", "screen"):
+        values, d_dx, d_dy = mr.interpolate(pos[:, :2], raster, tris, mode=mode, derivatives=True)
+        np.testing.assert_allclose(d_dx, np.broadcast_to([2 / W, 0], d_dx.shape), atol=1e-7)
+        np.testing.assert_allclose(d_dy, np.broadcast_to([0, -2 / H], d_dy.shape), atol=1e-7)
+        _, sx, sy = mr.interpolate(to_screen(pos[:, :2], W, H)[:, 1], raster, tris, mode=mode, derivatives=True)
+        assert sx.shape == (H, W, 4)
+        np.testing.assert_allclose(sx, 0, atol=1e-6)
+        np.testing.assert_allclose(sy, 1, rtol=1e-6)  # screen y per pixel down
+
+
+def test_derivatives_keep_values_and_are_zero_for_flat_and_uncovered_samples():
+    pos, tris = random_scene(8, n=20, size=0.4)
+    raster = mr.rasterize(pos, tris, 40, 30, spp=4)
+    covered = raster.triangle_id >= 0
+    assert 0 < covered.mean() < 1
+    attr = np.random.default_rng(8).uniform(-1, 1, (len(pos), 3))
+    for mode in ("perspective", "screen", "flat"):
+        for a in (attr, attr[:, 1]):
+            plain = mr.interpolate(a, raster, tris, mode=mode)
+            values, d_dx, d_dy = mr.interpolate(a, raster, tris, mode=mode, derivatives=True)
+            np.testing.assert_array_equal(values, plain)
+            assert d_dx.shape == d_dy.shape == plain.shape and d_dx.dtype == d_dy.dtype == np.float32
+            assert (d_dx[~covered] == 0).all() and (d_dy[~covered] == 0).all()
+            if mode == "flat":
+                assert (d_dx == 0).all() and (d_dy == 0).all()
+            else:
+                assert np.abs(d_dx[covered]).max() > 0 and np.abs(d_dy[covered]).max() > 0
+    assert mr.interpolate(attr, raster, tris, derivatives=False).shape == (30, 40, 4, 3)
+    with pytest.raises(TypeError, match="derivatives"):
+        mr.interpolate(attr, raster, tris, derivatives="yes")
+
+
+def test_raster_keeps_a_copy_of_the_clip_positions():
+    pos, tris = random_scene(9, n=4)
+    raster = mr.rasterize(pos, tris, 8, 8)
+    np.testing.assert_array_equal(raster.pos_clip, pos)
+    np.testing.assert_array_equal(raster.w, pos[:, 3])
+    pos[:] = 0.0  # the caller's array (already float64 and contiguous) may change afterwards
+    assert (raster.pos_clip[:, 3] > 0).all()
