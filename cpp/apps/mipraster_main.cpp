@@ -10,6 +10,7 @@
 // renders the built-in demo. Usage errors exit with status 2, failures with 1; every message names the bad input.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -299,6 +300,10 @@ int run_render(const std::vector<std::string>& args) {
         draws = loaded.draws;
     }
     override_samplers(o, draws);
+    const bool sampler_flags = !o.filter.empty() || o.max_aniso > 0.0 || o.has_lod_bias || !o.wrap.empty() ||
+                               o.settings.debug_view != DebugView::none;
+    if (sampler_flags && !o.quiet && std::none_of(draws.begin(), draws.end(), [](const Draw& d) { return bool(d.texture); }))
+        std::fprintf(stderr, "mipraster: warning: the scene has no textured draw; the texture options change nothing\n");
     if (!o.quiet && isatty(STDOUT_FILENO)) settings.progress = draw_progress;
     const RenderResult result = render(draws, camera, settings);
     write_image(o.output, result.color);

@@ -222,3 +222,13 @@ def test_help_and_version():
     assert r.returncode == 0 and "render" in r.stdout and "--spp" in r.stdout
     r = run("--version")
     assert r.returncode == 0 and r.stdout.startswith("mipraster ")
+
+
+def test_texture_options_on_an_untextured_scene_warn(tmp_path):
+    obj = tmp_path / "tri.obj"
+    obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    r = run("render", str(obj), "-o", str(tmp_path / "tri.png"), "--size", "32x32", "--filter", "ewa")
+    assert r.returncode == 0, r.stderr
+    assert "no textured draw" in r.stderr
+    quiet = run("render", str(obj), "-o", str(tmp_path / "tri.png"), "--size", "32x32", "--filter", "ewa", "--quiet")
+    assert quiet.returncode == 0 and quiet.stderr == ""
