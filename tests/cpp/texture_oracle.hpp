@@ -109,6 +109,8 @@ inline double lod_from_rho(double rho, const mr::Sampler& s, int levels) {
     double lambda = std::isfinite(rho) ? (rho > 0.0 ? std::log2(rho) + s.lod_bias
                                                     : -std::numeric_limits<double>::infinity())
                                        : std::numeric_limits<double>::infinity();
+    // The documented snap (sample.hpp): λ within 1e-6 of an integer is that integer.
+    if (std::abs(lambda - std::round(lambda)) < 1e-6) lambda = std::round(lambda);
     lambda = std::min(std::max(lambda, double(s.min_lod)), double(s.max_lod));
     return std::min(std::max(lambda, 0.0), double(levels - 1));
 }
@@ -325,7 +327,7 @@ inline glm::dvec4 ewa(const LevelFn& level, int size, int levels, double u, doub
         if (n > 0.0) { ex /= n; ey /= n; } else { ex = a >= c ? 1.0 : 0.0; ey = a >= c ? 0.0 : 1.0; }
     }
     l2 = std::max(l2, l1 / (double(s.max_anisotropy) * s.max_anisotropy));
-    int k = std::sqrt(l2) > min_axis ? int(std::floor(std::log2(std::sqrt(l2) / min_axis))) : 0;
+    int k = std::sqrt(l2) > min_axis ? int(std::floor(std::log2(std::sqrt(l2) / min_axis) + 1e-6)) : 0;  // the snap
     k = std::max(k, int(std::ceil(std::clamp(double(s.min_lod), 0.0, double(levels)))));
     k = std::min(k, int(std::floor(std::clamp(double(s.max_lod), 0.0, double(levels)))));
     k = std::clamp(k, 0, levels - 1);

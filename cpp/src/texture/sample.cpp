@@ -10,6 +10,9 @@ namespace mipraster {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// λ within this of an integer is taken as that integer (float derivatives carry ~1e-7 relative
+// error; log2 turns that into ~1e-7 absolute).
+constexpr double kLodSnap = 1e-6;
 
 // A texel-space coordinate moved by whole periods (repeat, mirror) or clamped just past the
 // edges (clamp, border), so that its floor and the indices next to it fit an int. No float
@@ -111,6 +114,9 @@ Footprint texel_footprint(const TextureView& t, glm::vec2 dx, glm::vec2 dy) {
 // λ from a footprint size ρ in texels: log2 ρ + bias, clamped; non-finite ρ → the coarsest level.
 double lod_from_size(double rho, const Sampler& s, int levels) {
     double lambda = std::isfinite(rho) ? std::log2(rho) + s.lod_bias : kInf;  // log2(0) = −inf
+    // Derivatives arrive as floats: a footprint of exactly 2^k texels comes out a few ulps short.
+    // Snap such λ to the integer, so it reads one level, not two (the other at weight ~1e-8).
+    if (std::abs(lambda - std::nearbyint(lambda)) < kLodSnap) lambda = std::nearbyint(lambda);
     lambda = std::clamp(lambda, double(s.min_lod), double(s.max_lod));
     return std::clamp(lambda, 0.0, double(levels - 1));  // [0, levels − 1] even for a negative min_lod
 }
@@ -229,7 +235,7 @@ glm::dvec4 ewa(const TextureView& t, double u, double v, const Footprint& f, con
     // The finest level where the minor semi-axis spans kEwaMinAxisTexels.
     int k = 0;
     const double minor = std::sqrt(minor2);
-    if (minor > kEwaMinAxisTexels) k = static_cast<int>(std::floor(std::log2(minor / kEwaMinAxisTexels)));
+    if (minor > kEwaMinAxisTexels) k = static_cast<int>(std::floor(std::log2(minor / kEwaMinAxisTexels) + kLodSnap));
     // min_lod and max_lod are any finite floats: clamp before the int conversion (UB beyond 2³¹).
     k = std::max(k, static_cast<int>(std::ceil(std::clamp(double(s.min_lod), 0.0, double(levels)))));
     k = std::min(k, static_cast<int>(std::floor(std::clamp(double(s.max_lod), 0.0, double(levels)))));

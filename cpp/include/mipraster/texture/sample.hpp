@@ -20,7 +20,9 @@ inline constexpr double kEwaAlpha = 6.0;
 /// λ of a lookup: isotropic and EWA/SAT footprints use ρ = max(‖∂uv/∂x‖, ‖∂uv/∂y‖) in texels,
 /// anisotropic uses Pmax/N (EXT_texture_filter_anisotropic); then + bias, clamped to
 /// [min_lod, max_lod] and [0, levels − 1]. Infinite or NaN derivatives give the coarsest level
-/// allowed (levels − 1, or max_lod when smaller).
+/// allowed (levels − 1, or max_lod when smaller). λ within 1e-6 of an integer is snapped to it:
+/// float derivatives of an exact 2^k footprint come out a few ulps short, and should read one
+/// level, not two.
 /// λ ≤ 0 means magnification (the mag filter on level 0).
 double texture_lod(const TextureView& texture, const Sampler& sampler, glm::vec2 duv_dx, glm::vec2 duv_dy);
 
