@@ -166,6 +166,33 @@ TEST(TextureLevels, ConstantLevelReducesToItselfExactly) {
     }
 }
 
+// The largest texture the issue names: 16384² (4 GiB of RGBA float at level 0, 1.3 GiB of levels).
+// A checker of 2048-texel squares has exact box means at every level: level k ≤ 11 is a checker of
+// 2048/2^k-texel squares, levels 12 and finer-than-a-square average to 0.5 exactly.
+TEST(TextureLevels, A16384SquareTextureBuildsEveryLevelExactly) {
+    constexpr int n = 16384, square = 2048;
+    mr::TextureLevel level0(n, n);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) level0.at(x, y) = glm::vec4(float((x / square + y / square) % 2));
+    mr::Texture tex(std::move(level0), "checker 16384");
+    mr::TextureView view(tex);
+    ASSERT_EQ(view.level_count(), 15);
+    for (int k = 1; k < view.level_count(); ++k) {
+        const mr::TextureLevel& level = view.level(k);
+        ASSERT_EQ(level.width, n >> k);
+        const int side = square >> k;  // squares at level k, in texels (0 once they are smaller)
+        for (int y = 0; y < level.height; y += std::max(1, level.height / 64))
+            for (int x = 0; x < level.width; x += std::max(1, level.width / 64)) {
+                const float expected = side >= 1 ? float((x / side + y / side) % 2) : 0.5f;
+                ASSERT_EQ(level.at(x, y).r, expected) << "level " << k << " texel " << x << "," << y;
+            }
+    }
+    // Trilinear half-way between levels 12 and 13 (both uniformly 0.5) is 0.5.
+    const mr::Sampler s = mr::Sampler::from_filter_name("trilinear");
+    const float d = std::ldexp(1.0f, 12) * std::sqrt(2.0f) / n;
+    EXPECT_EQ(mr::sample_texture(view, s, {0.3f, 0.7f}, {d, 0.0f}, {0.0f, d}).r, 0.5f);
+}
+
 // ---- LOD selection -----------------------------------------------------------------------------
 
 mr::Texture random_texture(int w, int h, std::uint64_t seed) { return mr::Texture(to::random_level(w, h, seed), "random"); }
