@@ -18,6 +18,7 @@ constexpr double kLodSnap = 1e-6;
 // edges (clamp, border), so that its floor and the indices next to it fit an int. No float
 // reaches an int conversion before this (DESIGN.md §2.6).
 double reduce(double x, int n, WrapMode mode) {
+    if (x >= 0.0 && x < n) return x;  // inside the texture: every mode leaves it (and skips a division)
     switch (mode) {
         case WrapMode::repeat: return x - n * std::floor(x / n);
         case WrapMode::mirror: return x - 2.0 * n * std::floor(x / (2.0 * n));
@@ -185,11 +186,25 @@ glm::dvec4 anisotropic(const TextureView& t, double u, double v, const Footprint
     if (isotropic_lod(f, s, t.level_count()) <= 0.0) return texel_filter(t.level(0), u, v, s.mag_filter, s);
     const AnisoProbes p = aniso_probes(f, dx, dy, s, t.level_count());
     if (p.count == 1) return isotropic(t, u, v, p.lambda, s);
+    // The levels and the blend weight are the same for every probe (what mip_filter would pick).
+    const TextureLevel* fine = &t.level(0);
+    const TextureLevel* coarse = nullptr;
+    double blend = 0.0;
+    if (p.lambda > 0.0 && s.mip_filter == MipFilter::nearest) {
+        fine = &t.level(std::clamp(static_cast<int>(std::ceil(p.lambda + 0.5)) - 1, 0, t.level_count() - 1));
+    } else if (p.lambda > 0.0 && s.mip_filter == MipFilter::linear) {
+        const int k = std::min(static_cast<int>(p.lambda), t.level_count() - 1);
+        fine = &t.level(k);
+        blend = p.lambda - k;
+        if (blend > 0.0 && k + 1 < t.level_count()) coarse = &t.level(k + 1);
+    }
     glm::dvec4 sum(0.0);
     for (int i = 0; i < p.count; ++i) {
         const double o = (i + 0.5) / p.count - 0.5;
-        sum += p.lambda <= 0.0 ? texel_filter(t.level(0), u + o * p.du, v + o * p.dv, s.min_filter, s)
-                               : mip_filter(t, u + o * p.du, v + o * p.dv, p.lambda, s);
+        const double pu = u + o * p.du, pv = v + o * p.dv;
+        glm::dvec4 probe = texel_filter(*fine, pu, pv, s.min_filter, s);
+        if (coarse) probe += blend * (texel_filter(*coarse, pu, pv, s.min_filter, s) - probe);
+        sum += probe;
     }
     return sum / double(p.count);
 }
