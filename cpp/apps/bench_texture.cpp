@@ -241,6 +241,16 @@ std::string table(const std::vector<std::string>& filters, const std::vector<std
     return s;
 }
 
+// The non-empty items of a comma-separated list.
+std::vector<std::string> split_list(const char* text) {
+    std::vector<std::string> items;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ','))
+        if (!item.empty()) items.push_back(item);
+    return items;
+}
+
 int usage_error(const std::string& message) {
     std::fprintf(stderr, "mipraster_bench_texture: %s\n\n%s", message.c_str(), kUsage);
     return 2;
@@ -281,20 +291,13 @@ int run(int argc, char** argv) {
         } else if (a == "--filters") {
             const char* v = value();
             if (!v) return usage_error("--filters needs a value");
-            filter_names.clear();
-            std::stringstream ss(v);
-            std::string item;
-            while (std::getline(ss, item, ','))
-                if (!item.empty()) filter_names.push_back(item);
+            filter_names = split_list(v);
             if (filter_names.empty()) return usage_error("--filters: empty list");
         } else if (a == "--footprints") {
             const char* v = value();
             if (!v) return usage_error("--footprints needs a value");
             footprint_names.clear();
-            std::stringstream ss(v);
-            std::string item;
-            while (std::getline(ss, item, ',')) {
-                if (item.empty()) continue;
+            for (const std::string& item : split_list(v)) {
                 bool known = false;
                 for (const Footprint& f : kFootprints) known = known || item == f.name;
                 if (!known)

@@ -326,11 +326,11 @@ glm::dvec4 summed_area(const TextureView& t, double u, double v, const Footprint
 
 double texture_lod(const TextureView& t, const Sampler& s, glm::vec2 dx, glm::vec2 dy) {
     const Footprint f = texel_footprint(t, dx, dy);
-    if (s.footprint == FootprintFilter::anisotropic) {
-        if (isotropic_lod(f, s, t.level_count()) <= 0.0) return isotropic_lod(f, s, t.level_count());
+    const double lambda = isotropic_lod(f, s, t.level_count());
+    // Anisotropic minification reads its probes at log2(Pmax/N); magnification is the same for all.
+    if (s.footprint == FootprintFilter::anisotropic && lambda > 0.0)
         return aniso_probes(f, dx, dy, s, t.level_count()).lambda;
-    }
-    return isotropic_lod(f, s, t.level_count());
+    return lambda;
 }
 
 glm::vec4 sample_texture(const TextureView& t, const Sampler& s, glm::vec2 uv, glm::vec2 dx, glm::vec2 dy) {
