@@ -17,13 +17,17 @@ constexpr double kLodSnap = 1e-6;
 // A texel-space coordinate moved by whole periods (repeat, mirror) or clamped just past the
 // edges (clamp, border), so that its floor and the indices next to it fit an int. No float
 // reaches an int conversion before this (DESIGN.md §2.6).
-double reduce(double x, int n, WrapMode mode) {
-    if (x >= 0.0 && x < n) return x;  // inside the texture: every mode leaves it (and skips a division)
+[[gnu::noinline]] double reduce_outside(double x, int n, WrapMode mode) {
     switch (mode) {
         case WrapMode::repeat: return x - n * std::floor(x / n);
         case WrapMode::mirror: return x - 2.0 * n * std::floor(x / (2.0 * n));
         default: return std::clamp(x, -2.0, n + 2.0);
     }
+}
+
+inline double reduce(double x, int n, WrapMode mode) {
+    if (x >= 0.0 && x < n) return x;  // inside the texture: every mode leaves it (and skips a division)
+    return reduce_outside(x, n, mode);
 }
 
 // The centre of a footprint with half extent `extent` (texels), moved like reduce() but, for
@@ -69,29 +73,33 @@ glm::dvec4 nearest(const TextureLevel& level, double u, double v, const Sampler&
     return fetch(level, static_cast<int>(std::floor(x)), static_cast<int>(std::floor(y)), s);
 }
 
-// Bilinear between the four nearest texel centres, i = ⌊u·w − ½⌋. Written as lerps so equal
+// The bilinear blend of four texels a b / c d at fractions (ax, ay). Written as lerps so equal
 // neighbours give back their value exactly.
-glm::dvec4 bilinear(const TextureLevel& level, double u, double v, const Sampler& s) {
+inline glm::dvec4 lerp_quad(const glm::dvec4& a, const glm::dvec4& b, const glm::dvec4& c, const glm::dvec4& d,
+                            double ax, double ay) {
+    const glm::dvec4 top = a + ax * (b - a), bottom = c + ax * (d - c);
+    return top + ay * (bottom - top);
+}
+
+// The quad at (i, j) when part of it lies outside the texture: each texel wrapped on its own.
+// Out of line, so the in-range path below stays small enough to inline into the filter loops.
+[[gnu::noinline]] glm::dvec4 bilinear_wrapped(const TextureLevel& level, int i, int j, double ax, double ay,
+                                              const Sampler& s) {
+    return lerp_quad(fetch(level, i, j, s), fetch(level, i + 1, j, s), fetch(level, i, j + 1, s),
+                     fetch(level, i + 1, j + 1, s), ax, ay);
+}
+
+// Bilinear between the four nearest texel centres, i = ⌊u·w − ½⌋.
+inline glm::dvec4 bilinear(const TextureLevel& level, double u, double v, const Sampler& s) {
     const double x = reduce(u * level.width, level.width, s.wrap_u) - 0.5;
     const double y = reduce(v * level.height, level.height, s.wrap_v) - 0.5;
     const double fx = std::floor(x), fy = std::floor(y);
     const int i = static_cast<int>(fx), j = static_cast<int>(fy);
     const double ax = x - fx, ay = y - fy;
-    glm::dvec4 a, b, c, d;
-    if (i >= 0 && j >= 0 && i + 1 < level.width && j + 1 < level.height) {  // no wrapping: most lookups
-        const glm::vec4* row = &level.at(i, j);
-        a = glm::dvec4(row[0]);
-        b = glm::dvec4(row[1]);
-        c = glm::dvec4(row[level.width]);
-        d = glm::dvec4(row[level.width + 1]);
-    } else {
-        a = fetch(level, i, j, s);
-        b = fetch(level, i + 1, j, s);
-        c = fetch(level, i, j + 1, s);
-        d = fetch(level, i + 1, j + 1, s);
-    }
-    const glm::dvec4 top = a + ax * (b - a), bottom = c + ax * (d - c);
-    return top + ay * (bottom - top);
+    if (i < 0 || j < 0 || i + 1 >= level.width || j + 1 >= level.height) return bilinear_wrapped(level, i, j, ax, ay, s);
+    const glm::vec4* row = &level.at(i, j);  // no wrapping: most lookups
+    return lerp_quad(glm::dvec4(row[0]), glm::dvec4(row[1]), glm::dvec4(row[level.width]),
+                     glm::dvec4(row[level.width + 1]), ax, ay);
 }
 
 glm::dvec4 texel_filter(const TextureLevel& level, double u, double v, TexelFilter filter, const Sampler& s) {
@@ -181,6 +189,26 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
     return p;
 }
 
+// The mean of p.count probes along the major axis, each a lookup on `fine`, blended towards
+// `coarse` (when set) by `blend`. The filter is a template argument so that bilinear inlines
+// into the loop: this loop is most of an anisotropic lookup's time.
+template <TexelFilter kFilter>
+glm::dvec4 anisotropic_probes(const AnisoProbes& p, double u, double v, const TextureLevel* fine,
+                              const TextureLevel* coarse, double blend, const Sampler& s) {
+    const auto filter = [&s](const TextureLevel& level, double pu, double pv) {
+        return kFilter == TexelFilter::linear ? bilinear(level, pu, pv, s) : nearest(level, pu, pv, s);
+    };
+    glm::dvec4 sum(0.0);
+    for (int i = 0; i < p.count; ++i) {
+        const double o = (i + 0.5) / p.count - 0.5;
+        const double pu = u + o * p.du, pv = v + o * p.dv;
+        glm::dvec4 probe = filter(*fine, pu, pv);
+        if (coarse) probe += blend * (filter(*coarse, pu, pv) - probe);
+        sum += probe;
+    }
+    return sum / double(p.count);
+}
+
 glm::dvec4 anisotropic(const TextureView& t, double u, double v, const Footprint& f, glm::vec2 dx, glm::vec2 dy,
                        const Sampler& s) {
     if (isotropic_lod(f, s, t.level_count()) <= 0.0) return texel_filter(t.level(0), u, v, s.mag_filter, s);
@@ -198,15 +226,8 @@ glm::dvec4 anisotropic(const TextureView& t, double u, double v, const Footprint
         blend = p.lambda - k;
         if (blend > 0.0 && k + 1 < t.level_count()) coarse = &t.level(k + 1);
     }
-    glm::dvec4 sum(0.0);
-    for (int i = 0; i < p.count; ++i) {
-        const double o = (i + 0.5) / p.count - 0.5;
-        const double pu = u + o * p.du, pv = v + o * p.dv;
-        glm::dvec4 probe = texel_filter(*fine, pu, pv, s.min_filter, s);
-        if (coarse) probe += blend * (texel_filter(*coarse, pu, pv, s.min_filter, s) - probe);
-        sum += probe;
-    }
-    return sum / double(p.count);
+    if (s.min_filter == TexelFilter::linear) return anisotropic_probes<TexelFilter::linear>(p, u, v, fine, coarse, blend, s);
+    return anisotropic_probes<TexelFilter::nearest>(p, u, v, fine, coarse, blend, s);
 }
 
 // exp(−α·q) for q = r² in [0, 1], tabulated (linear interpolation between entries).
