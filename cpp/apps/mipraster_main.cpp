@@ -1,6 +1,7 @@
 // mipraster — the command-line renderer.
 //
 //   mipraster compare A B [--fail T] [--fail-fraction F] [--hard-fail H]
+//   mipraster bench [options]     (runs python3 -m mipraster.bench)
 //   mipraster render [SCENE] -o OUT.png [--camera N] [--size WxH] [--spp N] [--aa ssaa|msaa] [--pattern NAME]
 //                    [--look-at EX,EY,EZ,TX,TY,TZ] [--fov DEG] [--threads N]
 //                    [--filter F] [--max-aniso N] [--wrap W[,W]] [--lod-bias B] [--debug-view V]
@@ -48,6 +49,9 @@ constexpr const char* kUsage =
     "             (a textured cube on a textured checker plane to the horizon):\n"
     "             mipraster render [SCENE] -o OUT [options]\n"
     "  compare    compare two images value by value and print a report (idiff style)\n"
+    "  bench      frame times against Mesa's llvmpipe on the shared benchmark scenes; runs\n"
+    "             `python3 -m mipraster.bench` (interpreter: $MIPRASTER_PYTHON, else python3),\n"
+    "             see `mipraster bench --help`\n"
     "\n"
     "render options:\n"
     "  -o, --output PATH     output image: .png (sRGB 8-bit) or .exr (linear float)  [required]\n"
@@ -352,6 +356,22 @@ int run_compare(const std::vector<std::string>& args) {
     return report.passed ? 0 : 1;
 }
 
+// Commands written in Python (they drive numpy scenes and other renderers): replace this
+// process with `PYTHON -m MODULE ARGS...`, the interpreter from $MIPRASTER_PYTHON or python3.
+int run_python_module(const char* module, const std::vector<std::string>& args) {
+    const char* env = std::getenv("MIPRASTER_PYTHON");
+    const std::string python = env && *env ? env : "python3";
+    std::vector<std::string> words = {python, "-m", module};
+    words.insert(words.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    execvp(argv[0], argv.data());
+    std::fprintf(stderr, "mipraster: cannot run '%s -m %s': %s (set MIPRASTER_PYTHON to the interpreter that has "
+                 "the mipraster package)\n", python.c_str(), module, std::strerror(errno));
+    return 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -368,6 +388,7 @@ int main(int argc, char** argv) {
         }
         if (args[0] == "render") return run_render({args.begin() + 1, args.end()});
         if (args[0] == "compare") return run_compare({args.begin() + 1, args.end()});
+        if (args[0] == "bench") return run_python_module("mipraster.bench", {args.begin() + 1, args.end()});
         throw UsageError("unknown command '" + args[0] + "'");
     } catch (const UsageError& e) {
         std::fprintf(stderr, "mipraster: %s\n\n%s", e.what(), kUsage);
