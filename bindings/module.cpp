@@ -6,11 +6,13 @@
 
 namespace mipraster::bindings {
 void bind_compare(pybind11::module_& m);  // compare.cpp
+void bind_memory(pybind11::module_& m);   // memory.cpp
 void bind_texture(pybind11::module_& m);  // texture.cpp
 }  // namespace mipraster::bindings
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "mipraster's C++ core: meshes, cameras, draws, the renderer and image comparison (no file I/O; see mipraster._image).";
+    mipraster::bindings::bind_memory(m);
     mipraster::bindings::bind_texture(m);
     mipraster::bindings::bind_scene(m);
     mipraster::bindings::bind_render(m);

@@ -5,13 +5,14 @@
 //   mipraster render [SCENE] -o OUT.png [--camera N] [--size WxH] [--spp N] [--aa ssaa|msaa] [--pattern NAME]
 //                    [--look-at EX,EY,EZ,TX,TY,TZ] [--fov DEG] [--threads N]
 //                    [--filter F] [--max-aniso N] [--wrap W[,W]] [--lod-bias B] [--debug-view V]
-//                    [--derivatives analytic|quad] [--stats] [--stats-json PATH] [--quiet]
+//                    [--derivatives analytic|quad] [--memory-limit SIZE] [--stats] [--stats-json PATH] [--quiet]
 //
 // SCENE is a scene file (.obj, .gltf, .glb; see mipraster/io/scene_file.hpp); with none it
 // renders the built-in demo. Usage errors exit with status 2, failures with 1; every message names the bad input.
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "mipraster/core/compare.hpp"
+#include "mipraster/core/memory_limit.hpp"
 #include "mipraster/io/image_io.hpp"
 #include "mipraster/io/scene_file.hpp"
 #include "mipraster/pipeline/renderer.hpp"
@@ -66,6 +68,8 @@ constexpr const char* kUsage =
     "                        a scene file's camera: --camera N, else --look-at/--fov, else its\n"
     "                        first camera, else one that frames the scene's bounding box\n"
     "  --threads N           worker threads, 0 = all cores                     [0]\n"
+    "  --memory-limit SIZE   refuse renders and textures estimated above SIZE bytes\n"
+    "                        (suffix K, M, G or T for KiB, MiB, GiB, TiB)       [16G]\n"
     "texture options (override every textured draw's sampler; default: the scene's own):\n"
     "  --filter F            nearest, bilinear (no mip levels), trilinear, anisotropic, ewa, sat\n"
     "  --max-aniso N         most probes (anisotropic) or largest axis ratio (ewa), >= 1\n"
@@ -114,6 +118,25 @@ double parse_number(const std::string& option, const std::string& text) {
     if (used != text.size() || text.empty() || !std::isfinite(value))
         throw UsageError(option + ": expected a finite number, got '" + text + "'");
     return value;
+}
+
+// "512M", "16G", "1000000": bytes with an optional binary suffix K, M, G or T.
+std::uint64_t parse_bytes(const std::string& option, const std::string& text) {
+    std::string digits = text;
+    int shift = 0;
+    if (!digits.empty()) {
+        const std::string suffixes = "KMGT";
+        const std::size_t unit = suffixes.find(static_cast<char>(std::toupper(static_cast<unsigned char>(digits.back()))));
+        if (unit != std::string::npos) {
+            shift = 10 * static_cast<int>(unit + 1);
+            digits.pop_back();
+        }
+    }
+    const double value = digits.empty() ? -1.0 : parse_number(option, digits);
+    const double bytes = std::ldexp(value, shift);
+    if (!(bytes >= 1.0 && bytes < 0x1p63))
+        throw UsageError(option + ": expected a size in bytes >= 1 (e.g. 512M, 16G), got '" + text + "'");
+    return static_cast<std::uint64_t>(bytes);
 }
 
 // "a,b,c,..." with exactly `count` finite numbers.
@@ -208,6 +231,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
             o.settings.pattern_seed = static_cast<std::uint64_t>(parse_int(a, value()));
         } else if (a == "--threads") {
             o.settings.threads = parse_int(a, value());
+        } else if (a == "--memory-limit") {
+            set_memory_limit(parse_bytes(a, value()));
         } else if (a == "--camera") {
             o.camera = parse_int(a, value());
             if (o.camera < 0) throw UsageError("--camera: expected a camera index >= 0, got " + args[i]);

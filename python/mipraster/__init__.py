@@ -38,7 +38,7 @@ textures with their samplers, cameras) through the same module.
 returns a :class:`CompareReport`; :mod:`mipraster.testing` (imported explicitly) builds golden-image
 tests on it.
 """
-from ._core import linear_to_srgb, linear_to_srgb8, srgb_to_linear
+from ._core import MemoryLimitError, linear_to_srgb, linear_to_srgb8, memory_limit, set_memory_limit, srgb_to_linear
 from .camera import Camera
 from .compare import CompareReport, compare
 from .image import read_image, to_srgb8, write_image
@@ -56,6 +56,7 @@ __all__ = [
     "CompareReport",
     "Draw",
     "Material",
+    "MemoryLimitError",
     "Mesh",
     "Raster",
     "RenderResult",
@@ -68,10 +69,12 @@ __all__ = [
     "linear_to_srgb8",
     "load_scene",
     "interpolate",
+    "memory_limit",
     "rasterize",
     "read_image",
     "render",
     "resolve",
+    "set_memory_limit",
     "set_texture_cache_budget",
     "srgb_to_linear",
     "texture_cache_stats",

@@ -350,3 +350,15 @@ def texture_cache_stats() -> Dict[str, int]:
     """Keys: budget_bytes, derived_bytes, levels_built, tables_built, evictions, keyed_textures."""
 def set_texture_cache_budget(budget_bytes: int) -> None: ...
 def clear_texture_cache() -> None: ...
+
+# memory.cpp: the process-wide memory limit
+DEFAULT_MEMORY_LIMIT: int
+
+class MemoryLimitError(ValueError, MemoryError):
+    """Work refused because its estimated memory exceeds memory_limit()."""
+
+def memory_limit() -> int:
+    """The process-wide memory limit in bytes."""
+
+def set_memory_limit(bytes: int) -> None:
+    """Sets the process-wide memory limit in bytes; 0 restores the default."""

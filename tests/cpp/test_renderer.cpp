@@ -209,10 +209,12 @@ TEST(Renderer, BadResolutionThrowsNamingTheDimensionBeforeAllocating) {
     EXPECT_MESSAGE_HAS(big, "32768");
     // ... and the memory it would need: 10^10 pixels × (16 B colour + 4 B depth) = 190734 MiB.
     EXPECT_MESSAGE_HAS(big, "190734 MiB");
-    // Within the dimension limit but far beyond the memory limit (32768² × 64 samples × 20 bytes
-    // = 1.25 TiB): refused with the memory it would need, not a std::bad_alloc or a crash.
+    // Within the dimension limit but beyond the default memory limit (the kept samples alone are
+    // 32768² × 64 samples × 20 bytes = 1.25 TiB): refused with the memory it would need, not a
+    // std::bad_alloc or a crash.
     const std::string huge = invalid_argument_message(draws, settings(32768, 32768, 64));
-    EXPECT_MESSAGE_HAS(huge, "1310720 MiB");
+    EXPECT_MESSAGE_HAS(huge, "a render of 32768x32768 pixels at 64 samples per pixel needs 1.27 TiB");
+    EXPECT_MESSAGE_HAS(huge, "the memory limit is 16.0 GiB");
 }
 
 TEST(Renderer, BadSampleCountsAndPatternsThrowNamingThem) {

@@ -85,7 +85,10 @@ def test_exr_output_is_openexr(tmp_path):
     [
         (["--size", "0x10"], ["width", "0"]),
         (["--size", "100000x100000"], ["width", "100000"]),
-        (["--size", "30000x30000", "--spp", "64"], ["MiB"]),
+        (["--size", "32768x32768", "--spp", "64"], ["a render of 32768x32768 pixels", "needs", "the memory limit is 16.0 GiB"]),
+        (["--memory-limit", "1M"], ["needs", "the memory limit is 1.00 MiB", "--memory-limit"]),
+        (["--memory-limit", "lots"], ["--memory-limit", "lots"]),
+        (["--memory-limit", "0"], ["--memory-limit", "'0'"]),
         (["--spp", "65"], ["samples", "65"]),
         (["--spp", "8", "--pattern", "rotated"], ["rotated", "4", "8"]),
         (["--aa", "fxaa"], ["fxaa", "ssaa", "msaa"]),

@@ -238,7 +238,8 @@ def test_scene_add_refuses_wrong_types(kwargs, words):
         (dict(height=40000), "height: expected 1 to 32768 pixels, got 40000"),
         (dict(spp=0), "samples per pixel: expected 1 to 64, got 0"),
         (dict(spp=65), "samples per pixel: expected 1 to 64, got 65"),
-        (dict(width=30000, height=30000, spp=64), "MiB"),
+        # 32768² pixels × (16 bytes of colour + 4 of depth output): 20 GiB, over the default 16
+        (dict(width=32768, height=32768, spp=64), "a render of 32768x32768 pixels at 64 samples per pixel needs 20.0 GiB"),
         (dict(spp=8, pattern="rotated"), "pattern 'rotated' has 4 samples; got samples=8"),
         (dict(spp=2, pattern="center"), "pattern 'center' has 1 sample; got samples=2"),
         (dict(threads=-1), "threads: expected 0 (all cores) to 256, got -1"),

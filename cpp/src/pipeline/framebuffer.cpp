@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "mipraster/core/constants.hpp"
+#include "mipraster/core/memory_limit.hpp"
 
 namespace mipraster {
 
@@ -28,16 +29,14 @@ void validate_framebuffer_size(int width, int height, int samples, bool with_dep
     if (samples < 1 || samples > kMaxSamples)
         throw std::invalid_argument("samples per pixel: expected 1 to " + std::to_string(kMaxSamples) + ", got " +
                                     std::to_string(samples));
-    const std::uint64_t bytes = framebuffer_bytes(width, height, samples, with_depth);
-    if (bytes > kMaxFramebufferBytes)
-        throw std::invalid_argument("framebuffer " + std::to_string(width) + "x" + std::to_string(height) + "x" +
-                                    std::to_string(samples) + " would need " + std::to_string(bytes >> 20) +
-                                    " MiB; the limit is " + std::to_string(kMaxFramebufferBytes >> 20) + " MiB");
 }
 
 Framebuffer make_framebuffer(int width, int height, int samples, glm::vec4 clear_color, bool with_depth,
                              float clear_depth) {
     validate_framebuffer_size(width, height, samples, with_depth);
+    check_memory(framebuffer_bytes(width, height, samples, with_depth),
+                 "a " + std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(samples) +
+                     " sample framebuffer");
     Framebuffer fb;
     fb.width = width;
     fb.height = height;

@@ -10,10 +10,12 @@
 #include <type_traits>
 
 #include "mipraster/core/constants.hpp"
+#include "mipraster/core/memory_limit.hpp"
 #include "mipraster/core/thread_pool.hpp"
 #include "mipraster/pipeline/binning.hpp"
 #include "mipraster/pipeline/clip.hpp"
 #include "mipraster/pipeline/rasterize_tile.hpp"
+#include "mipraster/pipeline/triangle_setup.hpp"
 #include "mipraster/pipeline/vertex_transform.hpp"
 
 namespace mipraster {
@@ -236,7 +238,32 @@ void add_counters(const std::vector<TileCounters>& tiles, RenderStats& stats) {
     }
 }
 
+// Per vertex and per triangle of the input, what transform, setup and binning hold.
+std::uint64_t geometry_bytes(std::uint64_t vertices, std::uint64_t triangles) {
+    return vertices * (sizeof(glm::dvec4) + 1) + triangles * (sizeof(SetupTriangle) + 2 * sizeof(std::uint32_t));
+}
+
+// What a render allocates, estimated before it allocates: the output images, the kept samples,
+// each worker's tile buffers, and the geometry.
+std::uint64_t render_bytes(const std::vector<Draw>& draws, const RenderSettings& settings, int threads,
+                           bool needs_depth, bool depth_output) {
+    const std::uint64_t pixels = std::uint64_t(settings.width) * std::uint64_t(settings.height);
+    const std::uint64_t sample_bytes = (4 + (needs_depth ? 1 : 0)) * sizeof(float);
+    std::uint64_t bytes = pixels * 4 * sizeof(float);  // the resolved colour
+    if (depth_output) bytes += pixels * sizeof(float);
+    if (settings.keep_samples) bytes += framebuffer_bytes(settings.width, settings.height, settings.samples, needs_depth);
+    bytes += std::uint64_t(threads) * kTileSize * kTileSize * std::uint64_t(settings.samples) * sample_bytes;
+    for (const Draw& d : draws) bytes += geometry_bytes(d.mesh->positions.size(), d.mesh->triangles.size());
+    return bytes;
+}
+
+std::string render_description(int width, int height, int samples) {
+    return std::to_string(width) + "x" + std::to_string(height) + " pixels at " + std::to_string(samples) +
+           (samples == 1 ? " sample" : " samples") + " per pixel";
+}
+
 }  // namespace
+
 
 std::string to_string(AntiAliasing aa) { return aa == AntiAliasing::msaa ? "msaa" : "ssaa"; }
 
@@ -257,6 +284,8 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     const bool depth_output = settings.depth_output && needs_depth;
     const DepthDecoder decoder = depth_output ? camera.depth_decoder() : DepthDecoder{};
     const int threads = resolve_thread_count(settings.threads);
+    check_memory(render_bytes(draws, settings, threads, needs_depth, depth_output),
+                 "a render of " + render_description(settings.width, settings.height, settings.samples));
     ThreadPool pool(threads);
     RenderStats& stats = result.stats;
     stats.threads = threads;
@@ -377,6 +406,10 @@ Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::v
         throw std::invalid_argument("triangles: at most 2^31 - 1 triangles (ids are int32)");
     validate_triangle_indices(triangles, clip_positions.size(), "triangles");
     const int threads = resolve_thread_count(settings.threads);
+    // Per sample: triangle id, two barycentrics and depth (4 bytes each).
+    const std::uint64_t samples = std::uint64_t(settings.width) * std::uint64_t(settings.height) * settings.samples;
+    check_memory(samples * 16 + geometry_bytes(clip_positions.size(), triangles.size()),
+                 "rasterizing " + render_description(settings.width, settings.height, settings.samples));
     ThreadPool pool(threads);
     RenderStats& stats = out.stats;
     stats.threads = threads;

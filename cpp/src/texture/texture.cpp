@@ -12,6 +12,7 @@
 #include <glm/vec3.hpp>
 
 #include "mipraster/core/colour.hpp"
+#include "mipraster/core/memory_limit.hpp"
 
 namespace mipraster {
 
@@ -77,6 +78,9 @@ void check_size(int width, int height, int channels, const std::string& name) {
     if (channels < 1 || channels > 4)
         throw std::invalid_argument("texture '" + name + "': " + std::to_string(channels) +
                                     " channels; expected 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA)");
+    // Level 0 plus, when minified, its mip chain (at most a third more).
+    check_memory(bytes + bytes / 3, "texture '" + name + "' (" + std::to_string(width) + "x" + std::to_string(height) +
+                                        ", RGBA float with its mip chain)");
 }
 
 // Expands 1–4 channels to premultiplied RGBA. `colour(i)` and `alpha(i)` decode raw value i.

@@ -32,9 +32,6 @@ inline constexpr int kMaxSamples = 64;
 inline constexpr int kTileSize = 32;
 static_assert(kTileSize % 8 == 0 && kTileSize <= 256, "tile size must be a small multiple of 8");
 
-/// Refuse framebuffers larger than this (colour + depth for all samples) before allocating.
-inline constexpr std::uint64_t kMaxFramebufferBytes = std::uint64_t{16} << 30;
-
 /// Clipped vertices keep w at least this large so 1/w is finite (the near plane of a sane camera
 /// is far above it; it matters only for degenerate user matrices).
 inline constexpr double kMinClipW = 1e-30;

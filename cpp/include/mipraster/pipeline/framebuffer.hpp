@@ -53,11 +53,12 @@ SampleWindow depth_window(Framebuffer& framebuffer);
 /// Bytes a framebuffer of this size needs (colour, plus depth when asked for).
 std::uint64_t framebuffer_bytes(int width, int height, int samples, bool with_depth);
 
-/// Checks the size (1…kMaxDimension each, samples 1…kMaxSamples, within kMaxFramebufferBytes)
-/// before anything is allocated; the error names the input and the memory it would need.
+/// Checks the size (1…kMaxDimension each, samples 1…kMaxSamples) before anything is allocated;
+/// the error names the input and the memory it would need. (The bytes are checked against
+/// memory_limit() by make_framebuffer and, for a whole render, by render.)
 void validate_framebuffer_size(int width, int height, int samples, bool with_depth);
 
-/// Allocates and clears a framebuffer.
+/// Allocates and clears a framebuffer; throws MemoryLimitError above memory_limit().
 Framebuffer make_framebuffer(int width, int height, int samples, glm::vec4 clear_color, bool with_depth,
                              float clear_depth);
 

@@ -1,0 +1,37 @@
+// The process-wide memory limit and the exception raised when work would exceed it.
+#include <pybind11/pybind11.h>
+
+#include "mipraster/core/memory_limit.hpp"
+
+namespace py = pybind11;
+
+namespace mipraster::bindings {
+
+void bind_memory(py::module_& m) {
+    // Both a ValueError (bad input, as before the limit was configurable) and a MemoryError.
+    static PyObject* const error_type = [] {
+        py::tuple bases = py::make_tuple(py::handle(PyExc_ValueError), py::handle(PyExc_MemoryError));
+        return PyErr_NewExceptionWithDoc("mipraster._core.MemoryLimitError",
+                                         "Work refused because its estimated memory exceeds memory_limit().",
+                                         bases.ptr(), nullptr);
+    }();
+    m.attr("MemoryLimitError") = py::handle(error_type);
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const MemoryLimitError& e) {
+            PyErr_SetString(error_type, e.what());
+        }
+    });
+    m.def("memory_limit", &memory_limit, "The process-wide memory limit in bytes.");
+    m.def(
+        "set_memory_limit",
+        [](long long bytes) {
+            if (bytes < 0) throw py::value_error("memory limit: expected bytes >= 0 (0 = the default), got " + std::to_string(bytes));
+            set_memory_limit(static_cast<std::uint64_t>(bytes));
+        },
+        py::arg("bytes"), "Sets the process-wide memory limit in bytes; 0 restores the default.");
+    m.attr("DEFAULT_MEMORY_LIMIT") = kDefaultMemoryLimit;
+}
+
+}  // namespace mipraster::bindings

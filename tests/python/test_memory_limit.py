@@ -1,0 +1,72 @@
+"""The process-wide memory limit seen from Python: renders, rasterizations and textures estimated
+above it raise MemoryLimitError (a ValueError and a MemoryError) giving the estimate and the limit,
+before anything large is allocated."""
+import re
+
+import numpy as np
+import pytest
+
+import mipraster as mr
+
+
+@pytest.fixture
+def limit():
+    """Sets the limit for one test and restores the default after it."""
+    yield mr.set_memory_limit
+    mr.set_memory_limit(0)
+
+
+def triangle_scene():
+    scene = mr.Scene()
+    scene.add(mr.Mesh([[-0.5, -0.5, 0], [0.5, -0.5, 0], [0, 0.5, 0]], [[0, 1, 2]]))
+    return scene
+
+
+def reported_bytes(message):
+    return int(re.search(r"\((\d+) bytes\)", message).group(1))
+
+
+def test_default_and_restore(limit):
+    assert mr.memory_limit() == mr._core.DEFAULT_MEMORY_LIMIT == 16 << 30
+    limit(12345)
+    assert mr.memory_limit() == 12345
+    limit(0)
+    assert mr.memory_limit() == 16 << 30
+    with pytest.raises(ValueError, match="memory limit: expected bytes >= 0"):
+        mr.set_memory_limit(-1)
+
+
+def test_render_refused_with_estimate_and_limit(limit):
+    scene, camera = triangle_scene(), mr.Camera.look_at((0, 0, 2), (0, 0, 0))
+    limit(1 << 20)
+    with pytest.raises(mr.MemoryLimitError) as e:
+        mr.render(scene, camera, 1000, 1000, spp=4, threads=1)
+    message = str(e.value)
+    assert "a render of 1000x1000 pixels at 4 samples per pixel needs" in message
+    assert "the memory limit is 1.00 MiB" in message
+    assert isinstance(e.value, MemoryError) and isinstance(e.value, ValueError)
+    # At least the resolved colour image; at the estimate itself the render goes ahead.
+    needed = reported_bytes(message)
+    assert needed >= 1000 * 1000 * 16
+    limit(needed)
+    assert mr.render(scene, camera, 1000, 1000, spp=4, threads=1).color.shape == (1000, 1000, 4)
+
+
+def test_keeping_samples_adds_the_sample_buffer(limit):
+    scene, camera = triangle_scene(), mr.Camera.look_at((0, 0, 2), (0, 0, 0))
+    limit(1)
+    sizes = {}
+    for keep in (False, True):
+        with pytest.raises(mr.MemoryLimitError) as e:
+            mr.render(scene, camera, 64, 32, spp=8, threads=1, keep_samples=keep)
+        sizes[keep] = reported_bytes(str(e.value))
+    # colour and depth (the draw tests depth): 20 bytes a sample
+    assert sizes[True] - sizes[False] == 64 * 32 * 8 * 20
+
+
+def test_rasterize_and_texture_refused(limit):
+    limit(1 << 20)
+    with pytest.raises(mr.MemoryLimitError, match="rasterizing 1000x1000 pixels at 1 sample per pixel needs"):
+        mr.rasterize(np.array([[-1, -1, 0, 1], [1, -1, 0, 1], [0, 1, 0, 1]], np.float32), [[0, 1, 2]], 1000, 1000)
+    with pytest.raises(mr.MemoryLimitError, match=r"texture 'wall' \(512x512, RGBA float with its mip chain\) needs 5.33 MiB"):
+        mr.Texture(np.zeros((512, 512, 4), np.uint8), name="wall")
