@@ -309,6 +309,37 @@ TEST(SceneFile, CorruptAndTruncatedFilesNameTheFile) {
     }
 }
 
+// tinyobjloader would read these coordinates as 0; the loader refuses them, naming the line.
+TEST(SceneFile, ObjCoordinatesThatAreNotFiniteNumbersNameTheLine) {
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1 ('v nan 0 0'): 'nan'"},
+        {"v 0 0 0\nv 1 inf 0\nv 0 1 0\nf 1 2 3\n", "line 2 ('v 1 inf 0'): 'inf'"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1,5 0\nf 1 2 3\n", "line 3 ('v 0 1,5 0'): '1,5'"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 x\nf 1 2 3\n", "line 4 ('vt 0.5 x'): 'x'"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1e999\nf 1 2 3\n", "'1e999' is not a finite number"},
+    };
+    for (const auto& [text, expected] : cases) {
+        const std::string path = write_file("not_a_number.obj", text);
+        const std::string e = error_of([&] { mr::load_scene(path); });
+        EXPECT_NE(e.find(expected), std::string::npos) << e;
+        EXPECT_NE(e.find(path), std::string::npos) << e;
+    }
+    // Comments after the numbers and CRLF line ends are fine.
+    const std::string ok = write_file("fine.obj", "v 0 0 0 # origin\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n");
+    EXPECT_EQ(error_of([&] { mr::load_scene(ok); }), "");
+}
+
+TEST(SceneFile, FileWithoutTrianglesLoadsWithAWarning) {
+    for (const auto& [name, text] : std::vector<std::pair<std::string, std::string>>{
+             {"empty.obj", ""}, {"points_only.obj", "v 0 0 0\nv 1 0 0\n"}, {"lines_only.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n"}}) {
+        const std::string path = write_file(name, text);
+        const mr::LoadedScene s = mr::load_scene(path);
+        bool warned = false;
+        for (const std::string& w : s.warnings) warned |= w.find(path + ": the file holds no triangles") == 0;
+        EXPECT_TRUE(warned) << name << ": " << s.warnings.size() << " other warnings";
+    }
+}
+
 TEST(SceneFile, NodeCycleIsAnError) {
     std::string json = gltf_json("\"uri\": \"data:application/octet-stream;base64," + base64(triangle_buffer()) + "\", ", 56);
     const std::string from = R"({"mesh": 0, "scale": [2, 2, 2]})";

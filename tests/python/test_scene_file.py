@@ -251,3 +251,19 @@ def test_hostile_texture_reference_is_an_error_naming_the_file(tmp_path):
     path.write_text(json.dumps(doc))
     with pytest.raises(OSError, match=r"bad_sampler\.gltf.*sampler 4 does not exist"):
         mr.load_scene(path)
+
+
+@pytest.mark.parametrize("text", ["", "v 0 0 0\nv 1 0 0\n"])
+def test_file_without_triangles_warns(tmp_path, text):
+    path = tmp_path / "nothing.obj"
+    path.write_text(text)
+    with pytest.warns(UserWarning, match="the file holds no triangles"):
+        scene, _ = mr.load_scene(path)
+    assert sum(len(d.mesh.triangles) for d in scene.draws) == 0
+
+
+def test_obj_coordinate_that_is_not_a_number_is_an_error(tmp_path):
+    path = tmp_path / "nan.obj"
+    path.write_text("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n")
+    with pytest.raises(OSError, match=r"line 2 \('v nan 0 0'\): 'nan' is not a finite number"):
+        mr.load_scene(path)

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
@@ -87,7 +88,29 @@ struct ObjGroup {
     bool all_uvs = true, all_normals = true;  // every corner has one
 };
 
+// tinyobjloader reads a coordinate it cannot parse ("nan", "inf", "1,5", "x") as 0: a silently
+// wrong mesh. Every number of the v / vt / vn lines must parse completely and be finite.
+void check_obj_numbers(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) fail(path, "cannot open OBJ file");
+    std::string line;
+    for (std::size_t number = 1; std::getline(in, line); ++number) {
+        std::istringstream words(line);
+        std::string keyword, word;
+        words >> keyword;
+        if (keyword != "v" && keyword != "vt" && keyword != "vn") continue;
+        while (words >> word && word[0] != '#') {
+            char* end = nullptr;
+            const double value = std::strtod(word.c_str(), &end);
+            if (end != word.c_str() + word.size() || !std::isfinite(value))
+                fail(path, "line " + std::to_string(number) + " ('" + trim(line) + "'): '" + word +
+                               "' is not a finite number");
+        }
+    }
+}
+
 LoadedScene load_obj(const std::string& path) {
+    check_obj_numbers(path);
     tinyobj::attrib_t attrib;
     std::vector<tinyobj::shape_t> shapes;
     std::vector<tinyobj::material_t> materials;
@@ -887,8 +910,13 @@ LoadedScene load_scene(const std::string& path) {
     if (ext != ".obj" && ext != ".gltf" && ext != ".glb")
         throw std::invalid_argument("load_scene: cannot tell the format of '" + path +
                                     "' from its extension; supported: .obj, .gltf, .glb");
-    if (ext == ".obj") return load_obj(path);
-    return load_gltf(path, ext == ".glb");
+    LoadedScene scene = ext == ".obj" ? load_obj(path) : load_gltf(path, ext == ".glb");
+    // Not an error (an empty file is a valid scene), but a render of it shows only the clear
+    // colour: say so rather than leave a blank image unexplained.
+    const bool any_triangle = std::any_of(scene.draws.begin(), scene.draws.end(),
+                                          [](const Draw& d) { return d.mesh && !d.mesh->triangles.empty(); });
+    if (!any_triangle) scene.warnings.push_back(path + ": the file holds no triangles; a render shows only the clear colour");
+    return scene;
 }
 
 bool scene_bounds(const std::vector<Draw>& draws, glm::dvec3& lo, glm::dvec3& hi) {
