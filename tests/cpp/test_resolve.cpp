@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -116,6 +117,23 @@ TEST(Resolve, BoxResolveIsTheMeanOfEachPixelsSamplesForRandomData) {
                     const bool inside = x >= x0 && x < x1 && y >= y0 && y < y1;
                     EXPECT_EQ(tile.at(x, y, c), inside ? img.at(x, y, c) : 0.0f) << "S=" << S << " (" << x << ", " << y << ")";
                 }
+    }
+}
+
+// The mean of finite samples is finite, however large they are: the sum must not overflow.
+TEST(Resolve, SamplesNearTheFloatMaximumResolveToTheirFiniteMean) {
+    const float big = std::numeric_limits<float>::max();
+    for (int S : {2, 4, 16, 64}) {
+        mr::Framebuffer fb;
+        fb.width = 2;
+        fb.height = 1;
+        fb.samples = S;
+        fb.color.assign(static_cast<std::size_t>(2 * S * 4), big);
+        for (int s = 0; s < S; ++s) fb.color[4 * fb.sample_index(1, 0, s)] = s % 2 ? big : -big;  // pixel 1, red: mean 0
+        mr::Image img(2, 1, 4);
+        mr::resolve_tile(mr::color_window(fb), 0, 0, 2, 1, mr::ResolveFilter::box, img);
+        for (int c = 0; c < 4; ++c) EXPECT_EQ(img.at(0, 0, c), big) << "S=" << S;
+        EXPECT_EQ(img.at(1, 0, 0), 0.0f) << "S=" << S;
     }
 }
 
