@@ -481,3 +481,49 @@ TEST(Clip, StatsCountASubmittedTriangleOnceWhateverItsClippedPieces) {
 }
 
 }  // namespace
+
+namespace {
+
+// A zero-area triangle reaching past the guard band used to be clipped first: the rounded crossing
+// points left the line and the pieces got area, covering samples along it (stress suite, case 8:
+// 434 samples from 400 collinear triangles). It is now culled before clipping, counted degenerate.
+TEST(Clip, CollinearTrianglesReachingPastTheGuardBandCoverNothing) {
+    const int W = 128;
+    std::mt19937_64 rng(3);
+    std::uniform_int_distribution<int> cell(0, W / 16 - 1), step(-4096, 4096);
+    std::vector<glm::dvec4> clip;
+    std::vector<glm::uvec3> tris;
+    for (int k = 0; k < 400; ++k) {
+        // Vertices c − 2^20·d, c, c + 2^20·d in 1/256 px units: exactly collinear in double NDC.
+        const glm::dvec2 c(cell(rng) * 4096.0, cell(rng) * 4096.0), d(step(rng), step(rng));
+        const std::uint32_t first = static_cast<std::uint32_t>(clip.size());
+        for (const double t : {-1048576.0, 0.0, 1048576.0}) {
+            const glm::dvec2 u = c + t * d;
+            clip.push_back(glm::dvec4(u.x / (128.0 * W) - 1.0, 1.0 - u.y / (128.0 * W), 0.0, 1.0));
+        }
+        tris.push_back(glm::uvec3(first, first + 1, first + 2));
+    }
+    mr::RasterizeSettings rs;
+    rs.width = rs.height = W;
+    rs.samples = 16;
+    rs.threads = 2;
+    const mr::Visibility vis = mr::rasterize(clip, tris, rs);
+    std::size_t covered = 0;
+    for (const std::int32_t id : vis.triangle_id) covered += id >= 0;
+    EXPECT_EQ(covered, 0u);
+    EXPECT_EQ(vis.stats.samples_covered, 0u);
+    EXPECT_EQ(vis.stats.triangles_degenerate, 400u);
+}
+
+TEST(Clip, ProjectsToALineFindsZeroAreaButNotThinTriangles) {
+    // Collinear on screen with different w; in a plane through the eye; a point.
+    EXPECT_TRUE(mr::projects_to_a_line({glm::dvec4(1, 2, 0, 1), glm::dvec4(4, 8, 5, 2), glm::dvec4(-3, -6, 1, -1)}));
+    EXPECT_TRUE(mr::projects_to_a_line({glm::dvec4(0, 0, 0, 1), glm::dvec4(0, 0, 0.5, 2), glm::dvec4(0.5, 0, 0, 1)}));
+    EXPECT_TRUE(mr::projects_to_a_line({glm::dvec4(3, 3, 0, 1), glm::dvec4(3, 3, 0, 1), glm::dvec4(3, 3, 0, 1)}));
+    // A sliver 2^31 px long (NDC 2^24 at W = 256) and 10^-3 px wide is a triangle.
+    const double half_px = 1.0 / 128.0;  // NDC per px at W = 256
+    EXPECT_FALSE(mr::projects_to_a_line({glm::dvec4(-16777216.0, 0, 0, 1), glm::dvec4(16777216.0, 0, 0, 1),
+                                         glm::dvec4(0.0, 1e-3 * half_px, 0, 1)}));
+}
+
+}  // namespace

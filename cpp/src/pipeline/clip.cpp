@@ -1,5 +1,8 @@
 #include "mipraster/pipeline/clip.hpp"
 
+#include <cmath>
+#include <limits>
+
 #include "mipraster/core/constants.hpp"
 
 namespace mipraster {
@@ -44,6 +47,17 @@ ClipVertex intersect(const ClipVertex& a, double da, const ClipVertex& b, double
 }
 
 }  // namespace
+
+bool projects_to_a_line(const std::array<glm::dvec4, 3>& p) {
+    // det[x y w] by the first column, and the same sum over absolute values (the permanent): the
+    // evaluation's rounding error is at most a few ulps of the permanent.
+    const double m0 = p[1].y * p[2].w - p[1].w * p[2].y, n0 = std::fabs(p[1].y * p[2].w) + std::fabs(p[1].w * p[2].y);
+    const double m1 = p[1].x * p[2].w - p[1].w * p[2].x, n1 = std::fabs(p[1].x * p[2].w) + std::fabs(p[1].w * p[2].x);
+    const double m2 = p[1].x * p[2].y - p[1].y * p[2].x, n2 = std::fabs(p[1].x * p[2].y) + std::fabs(p[1].y * p[2].x);
+    const double det = p[0].x * m0 - p[0].y * m1 + p[0].w * m2;
+    const double permanent = std::fabs(p[0].x) * n0 + std::fabs(p[0].y) * n1 + std::fabs(p[0].w) * n2;
+    return std::fabs(det) <= kProjectedAreaRoundingUlps * std::numeric_limits<double>::epsilon() * permanent;
+}
 
 std::uint8_t outcode(const glm::dvec4& p, const ClipVolume& volume) {
     std::uint8_t code = 0;
