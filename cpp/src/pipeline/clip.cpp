@@ -39,11 +39,20 @@ bool lexicographically_less(const glm::dvec4& a, const glm::dvec4& b) {
 }
 
 // The point where edge (a, b) crosses the plane, always computed from the lexicographically
-// smaller endpoint so that (a, b) and (b, a) give the same bits.
+// smaller endpoint so that (a, b) and (b, a) give the same bits. Position and weights are
+// computed in long double and rounded once: an endpoint 10^15 px away has a double ulp of 1/8 px,
+// and a + t·(b − a) in double would move the crossing that far off the edge's line (stress suite,
+// case 3); the crossing itself lies near the guard band, where double is ample.
 ClipVertex intersect(const ClipVertex& a, double da, const ClipVertex& b, double db) {
     if (lexicographically_less(b.position, a.position)) return intersect(b, db, a, da);
-    const double t = da / (da - db);
-    return {a.position + t * (b.position - a.position), a.weights + t * (b.weights - a.weights)};
+    using Wide = long double;
+    const Wide t = Wide(da) / (Wide(da) - Wide(db));
+    ClipVertex out;
+    for (int i = 0; i < 4; ++i)
+        out.position[i] = static_cast<double>(Wide(a.position[i]) + t * (Wide(b.position[i]) - Wide(a.position[i])));
+    for (int i = 0; i < 3; ++i)
+        out.weights[i] = static_cast<double>(Wide(a.weights[i]) + t * (Wide(b.weights[i]) - Wide(a.weights[i])));
+    return out;
 }
 
 }  // namespace
