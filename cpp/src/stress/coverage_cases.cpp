@@ -100,7 +100,7 @@ std::vector<StressRow> stress_slivers(StressSize size) {
     StressRow row;
     row.number = 2;
     row.name = "slivers";
-    const int W = full ? 256 : 128, angles = full ? 720 : 90;
+    const int W = full ? 256 : 128, angles = full ? 180 : 90;
     std::uint64_t samples = 0, mismatches = 0, covered = 0;
     bool finite = true;
     for (const double width : {1e-3, 1e-2, 1.0 / 256.0}) {
