@@ -12,13 +12,13 @@ namespace mipraster::bindings {
 void bind_stress(py::module_& m) {
     py::class_<StressRow>(m, "StressRow", "One row of the stress report: case, what was tried, figure, bound, pass.")
         .def_readonly("number", &StressRow::number, "The issue's case number, 1..12.")
-        .def_readonly("name", &StressRow::name)
+        .def_readonly("name", &StressRow::name, "Short name of the case, e.g. 'watertight'.")
         .def_readonly("tried", &StressRow::tried, "What was rendered or looked up.")
         .def_readonly("figure", &StressRow::figure, "The measured figure(s).")
         .def_readonly("bound", &StressRow::bound, "What the figure must meet.")
-        .def_readonly("passed", &StressRow::pass)
+        .def_readonly("passed", &StressRow::pass, "Whether the figure meets the bound.")
         .def_readonly("details", &StressRow::details, "Per-setting measurements behind the figure.")
-        .def("to_json", &StressRow::to_json)
+        .def("to_json", &StressRow::to_json, "The row as a JSON object.")
         .def("__repr__", &StressRow::to_string);
     m.def(
         "run_stress_suite",
