@@ -8,6 +8,7 @@ namespace mipraster::bindings {
 void bind_compare(pybind11::module_& m);  // compare.cpp
 void bind_memory(pybind11::module_& m);   // memory.cpp
 void bind_texture(pybind11::module_& m);  // texture.cpp
+void bind_stress(pybind11::module_& m);   // stress.cpp
 }  // namespace mipraster::bindings
 
 PYBIND11_MODULE(_core, m) {
@@ -17,4 +18,5 @@ PYBIND11_MODULE(_core, m) {
     mipraster::bindings::bind_scene(m);
     mipraster::bindings::bind_render(m);
     mipraster::bindings::bind_compare(m);
+    mipraster::bindings::bind_stress(m);
 }

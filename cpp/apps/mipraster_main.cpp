@@ -2,6 +2,7 @@
 //
 //   mipraster compare A B [--fail T] [--fail-fraction F] [--hard-fail H]
 //   mipraster bench [options]     (runs python3 -m mipraster.bench)
+//   mipraster stress [--full] [--json FILE] [--details]
 //   mipraster render [SCENE] -o OUT.png [--camera N] [--size WxH] [--spp N] [--aa ssaa|msaa] [--pattern NAME]
 //                    [--look-at EX,EY,EZ,TX,TY,TZ] [--fov DEG] [--threads N]
 //                    [--filter F] [--max-aniso N] [--wrap W[,W]] [--lod-bias B] [--debug-view V]
@@ -29,6 +30,7 @@
 #include "mipraster/io/scene_file.hpp"
 #include "mipraster/pipeline/renderer.hpp"
 #include "mipraster/scene/demo_scene.hpp"
+#include "mipraster/stress/stress_cases.hpp"
 
 namespace {
 
@@ -54,6 +56,8 @@ constexpr const char* kUsage =
     "  bench      frame times against Mesa's llvmpipe on the shared benchmark scenes; runs\n"
     "             `python3 -m mipraster.bench` (interpreter: $MIPRASTER_PYTHON, else python3),\n"
     "             see `mipraster bench --help`\n"
+    "  stress     run the numerical stress suite (issue 6) and print one row per case:\n"
+    "             what was tried, the figure measured, its bound, PASS/FAIL\n"
     "\n"
     "render options:\n"
     "  -o, --output PATH     output image: .png (sRGB 8-bit) or .exr (linear float)  [required]\n"
@@ -87,6 +91,12 @@ constexpr const char* kUsage =
     "  --fail T              a value fails when |a - b| > T                    [0.003921]\n"
     "  --fail-fraction F     the comparison fails when more than F of the values fail  [0]\n"
     "  --hard-fail H         ... or when any value differs by more than H      [1]\n"
+    "\n"
+    "stress [options]: exit status 0 when every row passes, 1 otherwise\n"
+    "  --full                the issue's sizes (>= 10^7 samples, a 16384^2 texture; minutes, ~6 GiB)\n"
+    "                        instead of the fast CI sizes\n"
+    "  --json FILE           also write the rows as JSON (- = stdout)\n"
+    "  --details             print the per-setting measurements under each row\n"
     "\n"
     "  mipraster --help | --version\n";
 
@@ -397,6 +407,42 @@ int run_python_module(const char* module, const std::vector<std::string>& args) 
     return 1;
 }
 
+int run_stress(const std::vector<std::string>& args) {
+    StressSize size = StressSize::fast;
+    std::string json;
+    bool details = false;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "--full") size = StressSize::full;
+        else if (a == "--details") details = true;
+        else if (a == "--json") {
+            if (i + 1 >= args.size()) throw UsageError("--json: missing value");
+            json = args[++i];
+        } else throw UsageError("stress: unknown option '" + a + "'");
+    }
+    std::FILE* out = json == "-" ? stderr : stdout;  // keep stdout pure JSON with --json -
+    std::FILE* json_file = nullptr;  // opened first: an unwritable path fails before minutes of work
+    if (!json.empty() && json != "-") {
+        json_file = std::fopen(json.c_str(), "w");
+        if (!json_file) throw std::runtime_error("cannot write " + json + ": " + std::strerror(errno));
+    }
+    std::fprintf(out, "mipraster stress suite (%s sizes)\n", to_string(size).c_str());
+    const std::vector<StressRow> rows = run_stress_suite(size, [&](const StressRow& r) {
+        std::fputs(format_stress_report({r}, details).c_str(), out);
+        std::fflush(out);
+    });
+    int failed = 0;
+    for (const StressRow& r : rows) failed += !r.pass;
+    std::fprintf(out, "%zu of %zu rows pass\n", rows.size() - failed, rows.size());
+    if (json == "-") {
+        std::fputs(stress_rows_to_json(rows).c_str(), stdout);
+    } else if (json_file) {
+        std::fputs(stress_rows_to_json(rows).c_str(), json_file);
+        std::fclose(json_file);
+    }
+    return failed ? 1 : 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -414,6 +460,7 @@ int main(int argc, char** argv) {
         if (args[0] == "render") return run_render({args.begin() + 1, args.end()});
         if (args[0] == "compare") return run_compare({args.begin() + 1, args.end()});
         if (args[0] == "bench") return run_python_module("mipraster.bench", {args.begin() + 1, args.end()});
+        if (args[0] == "stress") return run_stress({args.begin() + 1, args.end()});
         throw UsageError("unknown command '" + args[0] + "'");
     } catch (const UsageError& e) {
         std::fprintf(stderr, "mipraster: %s\n\n%s", e.what(), kUsage);

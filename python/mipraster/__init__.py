@@ -34,6 +34,9 @@ Image files (:func:`read_image`, :func:`write_image`, :meth:`RenderResult.save`)
 :func:`load_scene` reads OBJ and glTF scene files (geometry, colours, uvs, normals, base-colour
 textures with their samplers, cameras) through the same module.
 
+:func:`stress` runs the numerical stress suite (issue 6) and returns one :class:`StressRow` per
+case (also ``mipraster stress`` on the command line).
+
 :func:`compare` compares two images value by value with thresholds (OpenImageIO ``idiff`` style) and
 returns a :class:`CompareReport`; :mod:`mipraster.testing` (imported explicitly) builds golden-image
 tests on it.
@@ -47,6 +50,7 @@ from .primitives import Raster, interpolate, rasterize, resolve
 from .render import RenderResult, render
 from .scene import Draw, Material, Scene
 from .scene_file import load_scene
+from .stress import StressRow, format_stress_report, stress
 from .texture import Sampler, Texture, clear_texture_cache, set_texture_cache_budget, texture_cache_stats
 
 __version__ = "0.1.0"
@@ -62,9 +66,11 @@ __all__ = [
     "RenderResult",
     "Sampler",
     "Scene",
+    "StressRow",
     "Texture",
     "clear_texture_cache",
     "compare",
+    "format_stress_report",
     "linear_to_srgb",
     "linear_to_srgb8",
     "load_scene",
@@ -77,6 +83,7 @@ __all__ = [
     "set_memory_limit",
     "set_texture_cache_budget",
     "srgb_to_linear",
+    "stress",
     "texture_cache_stats",
     "to_srgb8",
     "write_image",

@@ -481,3 +481,100 @@ TEST(Clip, StatsCountASubmittedTriangleOnceWhateverItsClippedPieces) {
 }
 
 }  // namespace
+
+namespace {
+
+// A zero-area triangle reaching past the guard band used to be clipped first: the rounded crossing
+// points left the line and the pieces got area, covering samples along it (stress suite, case 8:
+// 434 samples from 400 collinear triangles). It is now culled before clipping, counted degenerate.
+TEST(Clip, CollinearTrianglesReachingPastTheGuardBandCoverNothing) {
+    const int W = 128;
+    std::mt19937_64 rng(3);
+    std::uniform_int_distribution<int> cell(0, W / 16 - 1), step(-4096, 4096);
+    std::vector<glm::dvec4> clip;
+    std::vector<glm::uvec3> tris;
+    for (int k = 0; k < 400; ++k) {
+        // Vertices c − 2^20·d, c, c + 2^20·d in 1/256 px units: exactly collinear in double NDC.
+        const glm::dvec2 c(cell(rng) * 4096.0, cell(rng) * 4096.0), d(step(rng), step(rng));
+        const std::uint32_t first = static_cast<std::uint32_t>(clip.size());
+        for (const double t : {-1048576.0, 0.0, 1048576.0}) {
+            const glm::dvec2 u = c + t * d;
+            clip.push_back(glm::dvec4(u.x / (128.0 * W) - 1.0, 1.0 - u.y / (128.0 * W), 0.0, 1.0));
+        }
+        tris.push_back(glm::uvec3(first, first + 1, first + 2));
+    }
+    mr::RasterizeSettings rs;
+    rs.width = rs.height = W;
+    rs.samples = 16;
+    rs.threads = 2;
+    const mr::Visibility vis = mr::rasterize(clip, tris, rs);
+    std::size_t covered = 0;
+    for (const std::int32_t id : vis.triangle_id) covered += id >= 0;
+    EXPECT_EQ(covered, 0u);
+    EXPECT_EQ(vis.stats.samples_covered, 0u);
+    EXPECT_EQ(vis.stats.triangles_degenerate, 400u);
+}
+
+TEST(Clip, ProjectsToALineFindsZeroAreaButNotThinTriangles) {
+    // Collinear on screen with different w; in a plane through the eye; a point.
+    EXPECT_TRUE(mr::projects_to_a_line({glm::dvec4(1, 2, 0, 1), glm::dvec4(4, 8, 5, 2), glm::dvec4(-3, -6, 1, -1)}));
+    EXPECT_TRUE(mr::projects_to_a_line({glm::dvec4(0, 0, 0, 1), glm::dvec4(0, 0, 0.5, 2), glm::dvec4(0.5, 0, 0, 1)}));
+    EXPECT_TRUE(mr::projects_to_a_line({glm::dvec4(3, 3, 0, 1), glm::dvec4(3, 3, 0, 1), glm::dvec4(3, 3, 0, 1)}));
+    // A sliver 2^31 px long (NDC 2^24 at W = 256) and 10^-3 px wide is a triangle.
+    const double half_px = 1.0 / 128.0;  // NDC per px at W = 256
+    EXPECT_FALSE(mr::projects_to_a_line({glm::dvec4(-16777216.0, 0, 0, 1), glm::dvec4(16777216.0, 0, 0, 1),
+                                         glm::dvec4(0.0, 1e-3 * half_px, 0, 1)}));
+}
+
+}  // namespace
+
+namespace {
+
+// Guard-band clipping computes the crossing point in long double: from endpoints 10^15 px away a
+// double a + t·(b − a) lands up to ~0.1 px off the edge's line (double's ulp there is 1/8 px), and
+// the clipped edge crossed the viewport that far from where it should (stress suite, case 3: 102
+// samples of 16 such triangles wrong by more than 2/256 px). Every sample farther than 2/256 px
+// from the exact edge must now agree with the exact coverage of the unclipped triangle.
+TEST(Clip, EdgesOfTrianglesReaching1e15PixelsCrossTheViewportWhereTheyShould) {
+    const int W = 256;
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> pos(0.1, 0.9), angle(0.0, 6.283185307179586);
+    mr::RasterizeSettings rs;
+    rs.width = rs.height = W;
+    rs.samples = 4;
+    rs.pattern = mr::PatternKind::rotated;
+    rs.threads = 2;
+    const oracle::Pattern pattern = oracle::rotated_pattern();
+    std::size_t wrong = 0, covered = 0;
+    for (int k = 0; k < 16; ++k) {
+        const glm::dvec2 q(pos(rng) * W, pos(rng) * W);
+        const double a = angle(rng);
+        const glm::dvec2 d(std::cos(a), std::sin(a)), n(-d.y, d.x);
+        const glm::dvec2 p[3] = {q - 1e15 * d, q + 1e15 * d, q + 1e15 * n};
+        std::vector<glm::dvec4> clip;
+        std::array<oracle::Fixed2, 3> v;
+        for (int i = 0; i < 3; ++i) {
+            const glm::dvec4 c(2.0 * p[i].x / W - 1.0, 1.0 - 2.0 * p[i].y / W, 0.0, 1.0);
+            clip.push_back(c);
+            v[i] = {oracle::snap((c.x + 1.0) * (0.5 * W) * 256.0), oracle::snap((1.0 - c.y) * (0.5 * W) * 256.0)};
+        }
+        const mr::Visibility vis = mr::rasterize(clip, {glm::uvec3(0, 1, 2)}, rs);
+        ASSERT_TRUE(same_offsets(to_oracle(vis.pattern), pattern));
+        for (int y = 0; y < W; ++y)
+            for (int x = 0; x < W; ++x)
+                for (int s = 0; s < 4; ++s) {
+                    const std::int64_t X = x * 256 + vis.pattern.x[s], Y = y * 256 + vis.pattern.y[s];
+                    const bool want = oracle::covers(v, X, Y);
+                    covered += want;
+                    if ((vis.triangle_id[(std::size_t(y) * W + x) * 4 + s] == 0) == want) continue;
+                    bool near_edge = false;
+                    for (int dy = -2; dy <= 2; dy += 2)
+                        for (int dx = -2; dx <= 2; dx += 2) near_edge = near_edge || oracle::covers(v, X + dx, Y + dy) != want;
+                    wrong += !near_edge;
+                }
+    }
+    EXPECT_GT(covered, 100000u);
+    EXPECT_EQ(wrong, 0u);
+}
+
+}  // namespace

@@ -143,6 +143,10 @@ void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices,
                 break;
             case ClipOutcome::clipped: {
                 ++clipped;
+                if (projects_to_a_line(p)) {  // zero area: clipping would round area into it
+                    ++counters.culled_degenerate;
+                    break;
+                }
                 // Fan-triangulate the clipped polygon; each piece keeps its original-triangle weights.
                 SetupCounters pieces;
                 bool any = false;

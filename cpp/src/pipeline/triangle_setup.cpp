@@ -84,9 +84,9 @@ bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport
     out.inv_area2 = 1.0 / static_cast<double>(sign * area2);
 
     // Step 5: depth (affine in screen space) and 1/w planes.
-    out.z0 = static_cast<float>(zw[0]);
-    out.dz1 = static_cast<float>(zw[1] - zw[0]);
-    out.dz2 = static_cast<float>(zw[2] - zw[0]);
+    out.z0 = zw[0];
+    out.dz1 = zw[1] - zw[0];
+    out.dz2 = zw[2] - zw[0];
     for (int i = 0; i < 3; ++i) out.inv_w[i] = static_cast<float>(inv_w[i]);
     return true;
 }

@@ -36,6 +36,14 @@ static_assert(kTileSize % 8 == 0 && kTileSize <= 256, "tile size must be a small
 /// is far above it; it matters only for degenerate user matrices).
 inline constexpr double kMinClipW = 1e-30;
 
+/// A triangle about to be clipped counts as projecting to a line when its homogeneous 3×3
+/// determinant is within this many double epsilons of its permanent: the determinant's own
+/// rounding (two products and a difference per minor, three terms) stays below 4 of them, so only
+/// triangles thinner than rounding can tell are culled (stress suite, case 8).
+inline constexpr double kProjectedAreaRoundingUlps = 8.0;
+static_assert(kProjectedAreaRoundingUlps >= 4.0 && kProjectedAreaRoundingUlps <= 64.0,
+              "above the determinant's rounding, far below any triangle a snapped sample can see");
+
 /// Most threads a render may ask for.
 inline constexpr int kMaxThreads = 256;
 

@@ -47,6 +47,13 @@ enum class ClipOutcome { inside, outside, clipped };
 /// when its vertices' outcodes OR to 0 and trivially outside when they AND to non-zero.
 std::uint8_t outcode(const glm::dvec4& p, const ClipVolume& volume);
 
+/// Whether the triangle projects to a line (or a point): its homogeneous vertices (x, y, w) are
+/// linearly dependent — collinear on screen, or in a plane through the eye — up to the rounding
+/// of the 3×3 determinant in double. Clipping such a triangle rounds its new vertices off the line
+/// and gives it area it does not have, so it is culled before clipping; an unclipped one is
+/// found exactly by setup's integer area.
+bool projects_to_a_line(const std::array<glm::dvec4, 3>& p);
+
 /// Classifies the triangle by its vertices' outcodes; when it crosses a plane, fills `out` with
 /// the clipped polygon (Sutherland–Hodgman). Each crossing point is computed from its edge's
 /// endpoints in a fixed order, so a shared edge clips to bit-identical vertices from either

@@ -21,7 +21,7 @@ struct SetupTriangle {
     std::array<std::int8_t, 3> bias;
     std::int32_t min_x, min_y, max_x, max_y;  ///< inclusive pixel bounds, inside the viewport
     double inv_area2;                         ///< 1 / (twice the area in 1/256² px²)
-    float z0, dz1, dz2;                       ///< depth = z0 + λ1·dz1 + λ2·dz2 (window depth)
+    double z0, dz1, dz2;                      ///< depth = z0 + λ1·dz1 + λ2·dz2 (window depth), rounded to float once
     std::array<float, 3> inv_w;               ///< 1/w at each vertex
     std::int32_t clip_index;                  ///< −1, or which clipped-weights entry maps vertices to the original
     std::uint32_t triangle;                   ///< index of the original triangle within its draw
