@@ -105,8 +105,10 @@ TEST(Synthesis, APerfectlyPeriodicSampleIsReproducedAsAShiftOfItself) {
 }
 
 TEST(Synthesis, TheSameSeedGivesTheSameOutputOnAnyThreadCountAndOtherSeedsDiffer) {
-    const mr::Image sample = random_image(24, 24, 3, 3);
-    mr::SynthesisSettings s = settings(32, 28, 7, 42);
+    // Large enough (48² candidates × up to 81 known pixels) that the search is split across threads.
+    const mr::Image sample = random_image(48, 48, 3, 3);
+    mr::SynthesisSettings s = settings(32, 28, 9, 42);
+    s.periodic_sample = true;
     s.threads = 1;
     const mr::SynthesisResult one = mr::synthesize_texture(sample, s);
     for (int threads : {1, 2, 3, 8}) {
@@ -222,6 +224,16 @@ TEST(Synthesis, TheAcceleratedSearchPicksWhatADirectSearchPicks) {
                 const mr::SynthesisResult r = mr::synthesize_texture(sample, s);
                 EXPECT_EQ(std::vector<int>(r.source.begin(), r.source.end()), expected);
             }
+    // A search large enough to be split across threads (40² candidates × up to 81 known pixels).
+    const mr::Image large = random_image(40, 40, 4, 6);
+    mr::SynthesisSettings s = settings(20, 16, 9, 10);
+    s.periodic_sample = true;
+    const std::vector<int> expected = direct_synthesis(large, s);
+    for (int threads : {1, 2, 3}) {
+        s.threads = threads;
+        const mr::SynthesisResult r = mr::synthesize_texture(large, s);
+        EXPECT_EQ(std::vector<int>(r.source.begin(), r.source.end()), expected) << threads << " threads";
+    }
 }
 
 TEST(Synthesis, SmallAndDegenerateSizesWork) {

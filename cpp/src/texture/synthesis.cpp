@@ -14,6 +14,11 @@ namespace mipraster {
 
 namespace {
 
+// The least work (candidate × known-pixel terms) worth handing to another thread: waking a
+// worker costs microseconds, about as long as this many terms take.
+constexpr std::size_t kSynthesisPairsPerTask = 32768;
+static_assert(kSynthesisPairsPerTask > 0, "a task has work");
+
 // splitmix64: a small, fast generator whose sequence is the same on every platform (the standard
 // distributions are not), so a seed means the same output everywhere.
 struct Random {
@@ -66,51 +71,89 @@ struct KnownPixel {
     float value[4];
 };
 
-// SSDs of the candidate rows [cy0, cy1) against the known pixels, into ssd[cy·candidates_x + cx].
-// Every candidate's sum runs over the known pixels in the same order whatever the rows, threads
-// or vector width, so the sums are bit-identical on every path. Four known pixels per sweep keep
-// the accumulator in registers longer without changing that order.
+// One known pixel as the sweep reads it: its weight and value in locals (registers), and the
+// start of its row in each channel plane.
 template <int C>
-void candidate_ssd(const SamplePlanes& p, const std::vector<KnownPixel>& known, int cy0, int cy1, float* ssd) {
-    const int nx = p.candidates_x;
-    const float* planes[4] = {};
-    for (int c = 0; c < C; ++c) planes[c] = p.plane(c);
-    auto term = [](const float* const* rows, const KnownPixel& k, int x) {
+struct Term {
+    const float* __restrict row[C];
+    float value[C];
+    float weight;
+
+    Term(const SamplePlanes& p, const KnownPixel& k, std::size_t row_start) : weight(k.weight) {
+        for (int c = 0; c < C; ++c) {
+            row[c] = p.plane(c) + row_start + k.offset;
+            value[c] = k.value[c];
+        }
+    }
+    /// The weighted squared colour difference at candidate column x.
+    [[gnu::always_inline]] float at(int x) const {
         float sum = 0.0f;
         for (int c = 0; c < C; ++c) {
-            const float d = rows[c][x] - k.value[c];
+            const float d = row[c][x] - value[c];
             sum += d * d;
         }
-        return k.weight * sum;
-    };
+        return weight * sum;
+    }
+};
+
+// SSDs of the candidate rows [cy0, cy1) against the known pixels, into ssd[cy·candidates_x + cx].
+// Every candidate's sum runs over the known pixels in the same order whatever the rows, threads
+// or vector width (no fused multiply-add: -ffp-contract=off, and the AVX2 build below enables no
+// FMA), so the sums are bit-identical on every path. Four known pixels per sweep keep the
+// accumulator in registers longer without changing that order.
+template <int C>
+[[gnu::always_inline]] inline void candidate_ssd_kernel(const SamplePlanes& p, const std::vector<KnownPixel>& known,
+                                                        int cy0, int cy1, float* ssd) {
+    const int nx = p.candidates_x;
     for (int cy = cy0; cy < cy1; ++cy) {
-        float* acc = ssd + static_cast<std::size_t>(cy) * nx;
-        std::fill(acc, acc + nx, 0.0f);
+        float* __restrict acc = ssd + static_cast<std::size_t>(cy) * nx;
+        for (int x = 0; x < nx; ++x) acc[x] = 0.0f;
         const std::size_t row = static_cast<std::size_t>(cy) * p.pitch;
         std::size_t k = 0;
         for (; k + 4 <= known.size(); k += 4) {
-            const float* r[4][4];
-            for (int j = 0; j < 4; ++j)
-                for (int c = 0; c < C; ++c) r[j][c] = planes[c] + row + known[k + j].offset;
-            const KnownPixel &k0 = known[k], &k1 = known[k + 1], &k2 = known[k + 2], &k3 = known[k + 3];
-            for (int x = 0; x < nx; ++x)
-                acc[x] = (((acc[x] + term(r[0], k0, x)) + term(r[1], k1, x)) + term(r[2], k2, x)) + term(r[3], k3, x);
+            const Term<C> t0(p, known[k], row), t1(p, known[k + 1], row), t2(p, known[k + 2], row),
+                t3(p, known[k + 3], row);
+            // ivdep: acc and the sample planes never overlap; without it GCC gives up on
+            // vectorizing (too many pointers to check for aliasing at run time).
+#pragma GCC ivdep
+            for (int x = 0; x < nx; ++x) acc[x] = (((acc[x] + t0.at(x)) + t1.at(x)) + t2.at(x)) + t3.at(x);
         }
         for (; k < known.size(); ++k) {
-            const float* r[4];
-            for (int c = 0; c < C; ++c) r[c] = planes[c] + row + known[k].offset;
-            for (int x = 0; x < nx; ++x) acc[x] += term(r, known[k], x);
+            const Term<C> t(p, known[k], row);
+#pragma GCC ivdep
+            for (int x = 0; x < nx; ++x) acc[x] += t.at(x);
         }
     }
 }
 
-void candidate_ssd(const SamplePlanes& p, const std::vector<KnownPixel>& known, int cy0, int cy1, float* ssd) {
-    switch (p.channels) {
-        case 1: return candidate_ssd<1>(p, known, cy0, cy1, ssd);
-        case 2: return candidate_ssd<2>(p, known, cy0, cy1, ssd);
-        case 3: return candidate_ssd<3>(p, known, cy0, cy1, ssd);
-        default: return candidate_ssd<4>(p, known, cy0, cy1, ssd);
+// The same kernel compiled for the x86-64 baseline (SSE2) and for AVX2 (twice the lanes); the
+// AVX2 one runs where the CPU has it.
+#define MIPRASTER_SSD_DISPATCH                                                \
+    switch (p.channels) {                                                     \
+        case 1: return candidate_ssd_kernel<1>(p, known, cy0, cy1, ssd);      \
+        case 2: return candidate_ssd_kernel<2>(p, known, cy0, cy1, ssd);      \
+        case 3: return candidate_ssd_kernel<3>(p, known, cy0, cy1, ssd);      \
+        default: return candidate_ssd_kernel<4>(p, known, cy0, cy1, ssd);     \
     }
+
+void candidate_ssd_baseline(const SamplePlanes& p, const std::vector<KnownPixel>& known, int cy0, int cy1, float* ssd) {
+    MIPRASTER_SSD_DISPATCH
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+[[gnu::target("avx2")]] void candidate_ssd_avx2(const SamplePlanes& p, const std::vector<KnownPixel>& known, int cy0,
+                                                int cy1, float* ssd) {
+    MIPRASTER_SSD_DISPATCH
+}
+const bool kHasAvx2 = __builtin_cpu_supports("avx2");
+#endif
+#undef MIPRASTER_SSD_DISPATCH
+
+void candidate_ssd(const SamplePlanes& p, const std::vector<KnownPixel>& known, int cy0, int cy1, float* ssd) {
+#if defined(__x86_64__) && defined(__GNUC__)
+    if (kHasAvx2) return candidate_ssd_avx2(p, known, cy0, cy1, ssd);
+#endif
+    candidate_ssd_baseline(p, known, cy0, cy1, ssd);
 }
 
 void validate(const Image& sample, const SynthesisSettings& s) {
@@ -215,7 +258,6 @@ SynthesisResult synthesize_texture(const Image& sample, const SynthesisSettings&
     // then stably sorted by how many known pixels its window holds (most first); its pixels are
     // synthesized in that order, each seeing the ones before it.
     ThreadPool pool(std::min(resolve_thread_count(settings.threads), ncy));
-    const std::size_t tasks = static_cast<std::size_t>(std::min(ncy, 4 * pool.size()));
     std::vector<float> ssd(candidates);
     std::vector<KnownPixel> neighbourhood;
     std::vector<std::uint32_t> matches;
@@ -258,6 +300,8 @@ SynthesisResult synthesize_texture(const Image& sample, const SynthesisSettings&
                     neighbourhood.push_back(k);
                 }
             // Every candidate's distance, the candidate rows split across the threads.
+            const std::size_t tasks = std::min<std::size_t>(
+                static_cast<std::size_t>(pool.size()), candidates * neighbourhood.size() / kSynthesisPairsPerTask);
             if (tasks <= 1) {
                 candidate_ssd(planes, neighbourhood, 0, ncy, ssd.data());
             } else {
