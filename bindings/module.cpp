@@ -7,6 +7,8 @@
 namespace mipraster::bindings {
 void bind_compare(pybind11::module_& m);  // compare.cpp
 void bind_texture(pybind11::module_& m);  // texture.cpp
+void bind_resample(pybind11::module_& m);  // resample.cpp
+void bind_synthesis(pybind11::module_& m);  // synthesis.cpp
 }  // namespace mipraster::bindings
 
 PYBIND11_MODULE(_core, m) {
@@ -15,4 +17,6 @@ PYBIND11_MODULE(_core, m) {
     mipraster::bindings::bind_scene(m);
     mipraster::bindings::bind_render(m);
     mipraster::bindings::bind_compare(m);
+    mipraster::bindings::bind_resample(m);
+    mipraster::bindings::bind_synthesis(m);
 }
