@@ -234,6 +234,19 @@ TEST(Synthesis, TheAcceleratedSearchPicksWhatADirectSearchPicks) {
         const mr::SynthesisResult r = mr::synthesize_texture(large, s);
         EXPECT_EQ(std::vector<int>(r.source.begin(), r.source.end()), expected) << threads << " threads";
     }
+    // A binary sample and a 3×3 window: many exact ties, so a pick changes as soon as one known
+    // pixel is missing, e.g. if pixels searched in parallel were not independent. 128² candidates
+    // make the search worth batching over threads.
+    mr::Image binary = random_image(128, 128, 1, 7);
+    for (float& v : binary.pixels) v = v < 0.5f ? 0.0f : 1.0f;
+    mr::SynthesisSettings b = settings(24, 20, 3, 11);
+    b.periodic_sample = true;
+    const std::vector<int> expected_binary = direct_synthesis(binary, b);
+    for (int threads : {1, 2, 3}) {
+        b.threads = threads;
+        const mr::SynthesisResult r = mr::synthesize_texture(binary, b);
+        EXPECT_EQ(std::vector<int>(r.source.begin(), r.source.end()), expected_binary) << threads << " threads";
+    }
 }
 
 TEST(Synthesis, SmallAndDegenerateSizesWork) {

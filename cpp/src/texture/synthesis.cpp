@@ -258,9 +258,38 @@ SynthesisResult synthesize_texture(const Image& sample, const SynthesisSettings&
     // then stably sorted by how many known pixels its window holds (most first); its pixels are
     // synthesized in that order, each seeing the ones before it.
     ThreadPool pool(std::min(resolve_thread_count(settings.threads), ncy));
-    std::vector<float> ssd(candidates);
-    std::vector<KnownPixel> neighbourhood;
+    // A batch has at most one pixel per thread, and only when a pixel's search is worth a thread.
+    const bool worth_batching = pool.size() > 1 && candidates * static_cast<std::size_t>(n) * n / 2 >= kSynthesisPairsPerTask;
+    const std::size_t max_batch = worth_batching ? static_cast<std::size_t>(pool.size()) : 1;
+    std::vector<std::vector<float>> ssds(max_batch, std::vector<float>(candidates));
+    std::vector<std::vector<KnownPixel>> neighbourhoods(max_batch);
+    std::vector<std::size_t> batch;
     std::vector<std::uint32_t> matches;
+    // The known pixels of pixel p's window.
+    auto gather_neighbourhood = [&](std::size_t p, std::vector<KnownPixel>& out) {
+        const int x = static_cast<int>(p % static_cast<std::size_t>(W)), y = static_cast<int>(p / static_cast<std::size_t>(W));
+        out.clear();
+        for (int dy = -r; dy <= r; ++dy)
+            for (int dx = -r; dx <= r; ++dx) {
+                const long q = neighbour(x, y, dx, dy);
+                if (q < 0 || !known[static_cast<std::size_t>(q)]) continue;
+                KnownPixel k{static_cast<std::size_t>(dy + r) * planes.pitch + static_cast<std::size_t>(dx + r),
+                             gauss[static_cast<std::size_t>(dy + r) * n + dx + r], {0, 0, 0, 0}};
+                for (int c = 0; c < C; ++c) k.value[c] = result.image.pixels[static_cast<std::size_t>(q) * C + c];
+                out.push_back(k);
+            }
+    };
+    // Whether pixels p and q are outside each other's windows (more than r apart along x or y,
+    // around the edges when the output tiles).
+    auto apart = [&](std::size_t p, std::size_t q) {
+        int dx = std::abs(static_cast<int>(p % static_cast<std::size_t>(W)) - static_cast<int>(q % static_cast<std::size_t>(W)));
+        int dy = std::abs(static_cast<int>(p / static_cast<std::size_t>(W)) - static_cast<int>(q / static_cast<std::size_t>(W)));
+        if (settings.tileable) {
+            dx = std::min(dx, W - dx);
+            dy = std::min(dy, H - dy);
+        }
+        return dx > r || dy > r;
+    };
     std::vector<std::pair<int, std::size_t>> layer;  // (known count, pixel)
     while (filled < known.size()) {
         layer.clear();
@@ -285,42 +314,56 @@ SynthesisResult synthesize_texture(const Image& sample, const SynthesisSettings&
         for (std::size_t i = layer.size(); i > 1; --i) std::swap(layer[i - 1], layer[random.below(i)]);
         std::stable_sort(layer.begin(), layer.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
 
-        for (const auto& entry : layer) {
-            const int x = static_cast<int>(entry.second % static_cast<std::size_t>(W));
-            const int y = static_cast<int>(entry.second / static_cast<std::size_t>(W));
-            // The known pixels of its window.
-            neighbourhood.clear();
-            for (int dy = -r; dy <= r; ++dy)
-                for (int dx = -r; dx <= r; ++dx) {
-                    const long q = neighbour(x, y, dx, dy);
-                    if (q < 0 || !known[static_cast<std::size_t>(q)]) continue;
-                    KnownPixel k{static_cast<std::size_t>(dy + r) * planes.pitch + static_cast<std::size_t>(dx + r),
-                                 gauss[static_cast<std::size_t>(dy + r) * n + dx + r], {0, 0, 0, 0}};
-                    for (int c = 0; c < C; ++c) k.value[c] = result.image.pixels[static_cast<std::size_t>(q) * C + c];
-                    neighbourhood.push_back(k);
-                }
-            // Every candidate's distance, the candidate rows split across the threads.
-            const std::size_t tasks = std::min<std::size_t>(
-                static_cast<std::size_t>(pool.size()), candidates * neighbourhood.size() / kSynthesisPairsPerTask);
-            if (tasks <= 1) {
-                candidate_ssd(planes, neighbourhood, 0, ncy, ssd.data());
-            } else {
-                pool.parallel_for(tasks, [&](std::size_t t) {
-                    candidate_ssd(planes, neighbourhood, static_cast<int>(t * ncy / tasks),
-                                  static_cast<int>((t + 1) * ncy / tasks), ssd.data());
-                });
+        // Pixels are searched in batches of consecutive layer pixels that are more than the
+        // window's radius apart: no member lies in a later member's window, so each one's known
+        // neighbourhood is what it would be one pixel at a time. Their searches run in parallel
+        // (one pixel per thread), then they are filled in layer order with the same random draws,
+        // so the output is the sequential one. A lone pixel splits its candidate rows instead.
+        std::size_t next = 0;
+        while (next < layer.size()) {
+            batch.assign(1, next);
+            std::size_t end = next + 1;
+            for (; end < layer.size() && batch.size() < max_batch; ++end) {
+                if (!std::all_of(batch.begin(), batch.end(), [&](std::size_t b) {
+                        return apart(layer[b].second, layer[end].second);
+                    }))
+                    break;
+                batch.push_back(end);
             }
-            // The candidates within (1 + ε) of the best; one of them at random.
-            const float best = *std::min_element(ssd.begin(), ssd.end());
-            const float limit = static_cast<float>(best * (1.0 + settings.epsilon));
-            matches.clear();
-            for (std::size_t i = 0; i < candidates; ++i)
-                if (ssd[i] <= limit) matches.push_back(static_cast<std::uint32_t>(i));
-            const std::uint32_t pick = matches[random.below(matches.size())];
-            const int cx = static_cast<int>(pick % static_cast<std::uint32_t>(ncx));
-            const int cy = static_cast<int>(pick / static_cast<std::uint32_t>(ncx));
-            fill(x, y, (cx + r) % sample.width, (cy + r) % sample.height);
-            ++filled;
+            for (std::size_t b = 0; b < batch.size(); ++b) gather_neighbourhood(layer[batch[b]].second, neighbourhoods[b]);
+            if (batch.size() > 1) {
+                pool.parallel_for(batch.size(), [&](std::size_t b) {
+                    candidate_ssd(planes, neighbourhoods[b], 0, ncy, ssds[b].data());
+                });
+            } else {
+                const std::size_t tasks = std::min<std::size_t>(
+                    static_cast<std::size_t>(pool.size()), candidates * neighbourhoods[0].size() / kSynthesisPairsPerTask);
+                if (tasks <= 1) {
+                    candidate_ssd(planes, neighbourhoods[0], 0, ncy, ssds[0].data());
+                } else {
+                    pool.parallel_for(tasks, [&](std::size_t t) {
+                        candidate_ssd(planes, neighbourhoods[0], static_cast<int>(t * ncy / tasks),
+                                      static_cast<int>((t + 1) * ncy / tasks), ssds[0].data());
+                    });
+                }
+            }
+            // In layer order: the candidates within (1 + ε) of the best; one of them at random.
+            for (std::size_t b = 0; b < batch.size(); ++b) {
+                const std::vector<float>& ssd = ssds[b];
+                const float best = *std::min_element(ssd.begin(), ssd.end());
+                const float limit = static_cast<float>(best * (1.0 + settings.epsilon));
+                matches.clear();
+                for (std::size_t i = 0; i < candidates; ++i)
+                    if (ssd[i] <= limit) matches.push_back(static_cast<std::uint32_t>(i));
+                const std::uint32_t pick = matches[random.below(matches.size())];
+                const int cx = static_cast<int>(pick % static_cast<std::uint32_t>(ncx));
+                const int cy = static_cast<int>(pick / static_cast<std::uint32_t>(ncx));
+                const std::size_t pixel = layer[batch[b]].second;
+                fill(static_cast<int>(pixel % static_cast<std::size_t>(W)), static_cast<int>(pixel / static_cast<std::size_t>(W)),
+                     (cx + r) % sample.width, (cy + r) % sample.height);
+                ++filled;
+            }
+            next = end;
         }
     }
     result.milliseconds =
