@@ -57,8 +57,9 @@ AxisTaps axis_taps(ResolveFilter filter, const std::vector<std::int32_t>& offset
     return a;
 }
 
-// Rows per parallel task.
+// Rows per parallel task: a few rows of W·S samples each, enough to hide the pool's hand-off.
 constexpr int kResolveRowsPerTask = 8;
+static_assert(kResolveRowsPerTask >= 1, "a task holds at least one row");
 
 }  // namespace
 
