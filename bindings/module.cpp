@@ -9,6 +9,8 @@ void bind_compare(pybind11::module_& m);  // compare.cpp
 void bind_memory(pybind11::module_& m);   // memory.cpp
 void bind_texture(pybind11::module_& m);  // texture.cpp
 void bind_stress(pybind11::module_& m);   // stress.cpp
+void bind_resample(pybind11::module_& m);  // resample.cpp
+void bind_synthesis(pybind11::module_& m);  // synthesis.cpp
 }  // namespace mipraster::bindings
 
 PYBIND11_MODULE(_core, m) {
@@ -19,4 +21,6 @@ PYBIND11_MODULE(_core, m) {
     mipraster::bindings::bind_render(m);
     mipraster::bindings::bind_compare(m);
     mipraster::bindings::bind_stress(m);
+    mipraster::bindings::bind_resample(m);
+    mipraster::bindings::bind_synthesis(m);
 }

@@ -171,6 +171,10 @@ void bind_render(py::module_& m) {
             [](RenderSettings& s, const CArray<float>& c) { s.clear_color = to_vec4(c, "clear_color"); },
             "premultiplied linear RGBA")
         .def_readwrite("keep_samples", &RenderSettings::keep_samples, "return the supersample framebuffer too")
+        .def_property(
+            "resolve_filter", [](const RenderSettings& s) { return to_string(s.resolve_filter); },
+            [](RenderSettings& s, const std::string& name) { s.resolve_filter = parse_resolve_filter(name); },
+            "reconstruction filter of the resolve: 'box', 'tent', 'mitchell', 'catmull-rom' or 'lanczos3'")
         .def_readwrite("depth_output", &RenderSettings::depth_output,
                        "return each pixel's view-space depth (nearest sample, +inf where empty)")
         .def_property(

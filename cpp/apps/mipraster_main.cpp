@@ -6,7 +6,10 @@
 //   mipraster render [SCENE] -o OUT.png [--camera N] [--size WxH] [--spp N] [--aa ssaa|msaa] [--pattern NAME]
 //                    [--look-at EX,EY,EZ,TX,TY,TZ] [--fov DEG] [--threads N]
 //                    [--filter F] [--max-aniso N] [--wrap W[,W]] [--lod-bias B] [--debug-view V]
-//                    [--derivatives analytic|quad] [--memory-limit SIZE] [--stats] [--stats-json PATH] [--quiet]
+//                    [--derivatives analytic|quad] [--resolve F] [--memory-limit SIZE] [--stats] [--stats-json PATH] [--quiet]
+//   mipraster resize IN -o OUT --size WxH [--filter F] [--threads N] [--quiet]
+//   mipraster synthesize SAMPLE -o OUT --size WxH [--window N] [--seed S] [--epsilon E] [--periodic]
+//                        [--tileable] [--threads N] [--quiet]
 //
 // SCENE is a scene file (.obj, .gltf, .glb; see mipraster/io/scene_file.hpp); with none it
 // renders the built-in demo. Usage errors exit with status 2, failures with 1; every message names the bad input.
@@ -15,6 +18,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -22,15 +26,19 @@
 #include <exception>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "mipraster/core/compare.hpp"
 #include "mipraster/core/memory_limit.hpp"
+#include "mipraster/core/resample.hpp"
 #include "mipraster/io/image_io.hpp"
 #include "mipraster/io/scene_file.hpp"
 #include "mipraster/pipeline/renderer.hpp"
 #include "mipraster/scene/demo_scene.hpp"
 #include "mipraster/stress/stress_cases.hpp"
+#include "mipraster/texture/synthesis.hpp"
 
 namespace {
 
@@ -58,6 +66,8 @@ constexpr const char* kUsage =
     "             see `mipraster bench --help`\n"
     "  stress     run the numerical stress suite (issue 6) and print one row per case:\n"
     "             what was tried, the figure measured, its bound, PASS/FAIL\n"
+  "  resize     resize an image with a reconstruction filter (in linear colour, widened when shrinking)\n"
+  "  synthesize grow a texture like a sample image (Efros & Leung non-parametric sampling)\n"
     "\n"
     "render options:\n"
     "  -o, --output PATH     output image: .png (sRGB 8-bit) or .exr (linear float)  [required]\n"
@@ -81,6 +91,8 @@ constexpr const char* kUsage =
     "  --lod-bias B          added to the level of detail (log2 texels per pixel)\n"
     "  --debug-view V        none, mip-level (a colour per mip level), uv (uv as colour)\n"
     "  --derivatives D       analytic (exact per sample) or quad (2x2 finite differences) [analytic]\n"
+  "  --resolve F           resolve filter: box (mean of the pixel's samples), tent, mitchell,\n"
+  "                        catmull-rom, lanczos3 (also weigh the samples of nearby pixels) [box]\n"
     "  --stats               print triangle, sample and per-stage time counts\n"
     "  --stats-json PATH     write the counts and times as JSON (- = stdout)\n"
     "  --quiet               print nothing but errors (no summary, no progress bar)\n"
@@ -98,7 +110,19 @@ constexpr const char* kUsage =
     "  --json FILE           also write the rows as JSON (- = stdout)\n"
     "  --details             print the per-setting measurements under each row\n"
     "\n"
-    "  mipraster --help | --version\n";
+    "resize IN -o OUT --size WxH [options]: read any image, write .png (sRGB 8-bit) or .exr\n"
+  "  --filter F            box, tent, mitchell, catmull-rom, lanczos3          [mitchell]\n"
+  "  --threads N           worker threads, 0 = all cores                     [0]\n"
+  "\n"
+  "synthesize SAMPLE -o OUT --size WxH [options]: every output pixel is copied from the sample\n"
+  "  --window N            odd neighbourhood side, at most the sample's sides [11]\n"
+  "  --seed S              random seed; the same seed gives the same output   [0]\n"
+  "  --epsilon E           draw among matches within (1 + E) of the best      [0.1]\n"
+  "  --periodic            the sample tiles: its neighbourhoods wrap around its edges\n"
+  "  --tileable            make the output tile (its neighbourhoods wrap around)\n"
+  "  --threads N           worker threads, 0 = all cores                     [0]\n"
+  "\n"
+  "  mipraster --help | --version\n";
 
 struct UsageError : std::runtime_error {
     using std::runtime_error::runtime_error;
@@ -272,6 +296,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
             o.settings.debug_view = parse_debug_view(value());
         } else if (a == "--derivatives") {
             o.settings.derivatives = parse_derivative_mode(value());
+        } else if (a == "--resolve") {
+            o.settings.resolve_filter = parse_resolve_filter(value());
         } else if (a == "--stats") {
             o.print_stats = true;
         } else if (a == "--stats-json") {
@@ -359,6 +385,108 @@ int run_render(const std::vector<std::string>& args) {
         std::fprintf(f, "%s\n", result.stats.to_json().c_str());
         std::fclose(f);
     }
+    return 0;
+}
+
+// "WxH" with both in 1…limit.
+std::pair<int, int> parse_size(const std::string& text, int limit) {
+    const auto x = text.find('x');
+    if (x == std::string::npos) throw UsageError("--size: expected WxH (e.g. 256x256), got '" + text + "'");
+    const int w = parse_int("--size width", text.substr(0, x)), h = parse_int("--size height", text.substr(x + 1));
+    if (w < 1 || h < 1 || w > limit || h > limit)
+        throw UsageError("--size: " + text + " is out of range; expected 1 to " + std::to_string(limit) + " each");
+    return {w, h};
+}
+
+// The options shared by resize and synthesize: one input, -o OUT, --size, --threads, --quiet;
+// `extra` handles the command's own options (returns false for an unknown one).
+struct ImageCommand {
+    std::string input, output;
+    int width = 0, height = 0, threads = 0;
+    bool quiet = false;
+};
+
+template <class Extra>
+ImageCommand parse_image_command(const char* command, const std::vector<std::string>& args, int size_limit,
+                                 Extra extra) {
+    ImageCommand o;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        auto value = [&]() -> const std::string& {
+            if (i + 1 >= args.size()) throw UsageError(a + ": missing value");
+            return args[++i];
+        };
+        if (a == "-o" || a == "--output") {
+            o.output = value();
+        } else if (a == "--size") {
+            std::tie(o.width, o.height) = parse_size(value(), size_limit);
+        } else if (a == "--threads") {
+            o.threads = parse_int(a, value());
+            resolve_thread_count(o.threads);  // throws naming threads
+        } else if (a == "--quiet") {
+            o.quiet = true;
+        } else if (extra(a, value)) {
+        } else if (!a.empty() && a[0] != '-' && o.input.empty()) {
+            o.input = a;
+        } else if (!a.empty() && a[0] != '-') {
+            throw UsageError(std::string(command) + ": more than one input image ('" + o.input + "', '" + a + "')");
+        } else {
+            throw UsageError(std::string(command) + ": unknown option '" + a + "'");
+        }
+    }
+    if (o.input.empty()) throw UsageError(std::string(command) + ": missing the input image");
+    if (o.output.empty()) throw UsageError(std::string(command) + ": missing -o PATH (where to write the image)");
+    if (o.width == 0) throw UsageError(std::string(command) + ": missing --size WxH");
+    return o;
+}
+
+int run_resize(const std::vector<std::string>& args) {
+    ReconstructionFilter filter = ReconstructionFilter::mitchell;
+    const ImageCommand o = parse_image_command("resize", args, kMaxResampleDimension, [&](const std::string& a, auto value) {
+        if (a != "--filter") return false;
+        filter = parse_reconstruction_filter(value());
+        return true;
+    });
+    const Image image = read_image(o.input);  // linear, premultiplied RGBA; std::runtime_error naming the file
+    const auto start = std::chrono::steady_clock::now();
+    const Image out = resample(image, o.width, o.height, filter, o.threads);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    write_image(o.output, out);
+    if (!o.quiet)
+        std::printf("wrote %s (%dx%d from %dx%d, %s, %.1f ms)\n", o.output.c_str(), o.width, o.height, image.width,
+                    image.height, to_string(filter).c_str(), ms);
+    return 0;
+}
+
+int run_synthesize(const std::vector<std::string>& args) {
+    SynthesisSettings settings;
+    const ImageCommand o = parse_image_command("synthesize", args, kMaxSynthesisDimension, [&](const std::string& a, auto value) {
+        if (a == "--window") settings.window = parse_int(a, value());
+        else if (a == "--seed") {
+            const int seed = parse_int(a, value());
+            if (seed < 0) throw UsageError("--seed: expected an integer >= 0, got " + std::to_string(seed));
+            settings.seed = static_cast<std::uint64_t>(seed);
+        } else if (a == "--epsilon") settings.epsilon = parse_number(a, value());
+        else if (a == "--periodic") settings.periodic_sample = true;
+        else if (a == "--tileable") settings.tileable = true;
+        else return false;
+        return true;
+    });
+    if (settings.window < 1 || settings.window % 2 == 0)
+        throw UsageError("--window: expected an odd size >= 1, got " + std::to_string(settings.window));
+    if (!(settings.epsilon >= 0.0)) throw UsageError("--epsilon: expected a number >= 0");
+    settings.width = o.width;
+    settings.height = o.height;
+    settings.threads = o.threads;
+    const Image sample = read_image(o.input);  // linear, premultiplied RGBA
+    if (settings.window > std::min(sample.width, sample.height))
+        throw std::invalid_argument("--window " + std::to_string(settings.window) + ": larger than the sample " +
+                                    o.input + " (" + std::to_string(sample.width) + "x" + std::to_string(sample.height) + ")");
+    const SynthesisResult r = synthesize_texture(sample, settings);
+    write_image(o.output, r.image);
+    if (!o.quiet)
+        std::printf("wrote %s (%dx%d from %s, window %d, seed %llu, %.1f ms)\n", o.output.c_str(), o.width, o.height,
+                    o.input.c_str(), settings.window, static_cast<unsigned long long>(settings.seed), r.milliseconds);
     return 0;
 }
 
@@ -461,6 +589,8 @@ int main(int argc, char** argv) {
         if (args[0] == "compare") return run_compare({args.begin() + 1, args.end()});
         if (args[0] == "bench") return run_python_module("mipraster.bench", {args.begin() + 1, args.end()});
         if (args[0] == "stress") return run_stress({args.begin() + 1, args.end()});
+        if (args[0] == "resize") return run_resize({args.begin() + 1, args.end()});
+        if (args[0] == "synthesize") return run_synthesize({args.begin() + 1, args.end()});
         throw UsageError("unknown command '" + args[0] + "'");
     } catch (const UsageError& e) {
         std::fprintf(stderr, "mipraster: %s\n\n%s", e.what(), kUsage);

@@ -36,6 +36,9 @@ textures with their samplers, cameras) through the same module.
 
 :func:`stress` runs the numerical stress suite (issue 6) and returns one :class:`StressRow` per
 case (also ``mipraster stress`` on the command line).
+:func:`resample` resizes an image with a reconstruction filter (box, tent, Mitchell–Netravali,
+Catmull–Rom, Lanczos-3; widened when shrinking, in linear colour) and :func:`synthesize` grows a new
+texture from a sample (Efros & Leung), ready to use as a :class:`Texture`.
 
 :func:`compare` compares two images value by value with thresholds (OpenImageIO ``idiff`` style) and
 returns a :class:`CompareReport`; :mod:`mipraster.testing` (imported explicitly) builds golden-image
@@ -48,9 +51,11 @@ from .image import read_image, to_srgb8, write_image
 from .mesh import Mesh
 from .primitives import Raster, interpolate, rasterize, resolve
 from .render import RenderResult, render
+from .resample import resample
 from .scene import Draw, Material, Scene
 from .scene_file import load_scene
 from .stress import StressRow, format_stress_report, stress
+from .synthesis import synthesize
 from .texture import Sampler, Texture, clear_texture_cache, set_texture_cache_budget, texture_cache_stats
 
 __version__ = "0.1.0"
@@ -79,11 +84,13 @@ __all__ = [
     "rasterize",
     "read_image",
     "render",
+    "resample",
     "resolve",
     "set_memory_limit",
     "set_texture_cache_budget",
     "srgb_to_linear",
     "stress",
+    "synthesize",
     "texture_cache_stats",
     "to_srgb8",
     "write_image",

@@ -180,6 +180,7 @@ class RenderSettings:
     depth_output: bool
     derivatives: str
     debug_view: str
+    resolve_filter: str
     def __init__(self) -> None: ...
     @property
     def clear_color(self) -> _RGBA: ...
@@ -385,3 +386,33 @@ class StressRow:
 def run_stress_suite(size: str = ...) -> List[StressRow]: ...
 def format_stress_report(rows: List[StressRow], with_details: bool = ...) -> str: ...
 def stress_rows_to_json(rows: List[StressRow]) -> str: ...
+
+# --- resampling (bindings/resample.cpp) ---------------------------------------------------------
+
+MAX_RESAMPLE_DIMENSION: int
+RECONSTRUCTION_FILTERS: str
+
+def resample(image: _ArrayLike, width: int, height: int, filter: str, threads: int = 0) -> npt.NDArray[np.float32]: ...
+def resample_weights(
+    source_size: int, target_size: int, filter: str
+) -> Tuple[npt.NDArray[np.int32], npt.NDArray[np.int32], npt.NDArray[np.float32], float]: ...
+def filter_weight(filter: str, x: float) -> float: ...
+def filter_radius(filter: str) -> float: ...
+
+# --- texture synthesis (bindings/synthesis.cpp) -------------------------------------------------
+
+MAX_SYNTHESIS_DIMENSION: int
+
+class SynthesisSettings:
+    width: int
+    height: int
+    window: int
+    seed: int
+    epsilon: float
+    periodic_sample: bool
+    tileable: bool
+    threads: int
+    def __init__(self) -> None: ...
+
+def synthesize(sample: _ArrayLike, settings: SynthesisSettings) -> Dict[str, Any]:
+    """Returns image (H, W, C) float32, source (H, W) int32, candidates, milliseconds."""

@@ -8,6 +8,7 @@ import numpy as np
 
 from . import _checks, _core
 from .camera import Camera
+from .resample import RESAMPLE_FILTERS
 from .scene import Scene, _core_draws
 
 __all__ = ["render", "RenderResult"]
@@ -105,7 +106,7 @@ def _int_in(value: Any, name: str, lo: int, hi: int, expected: str) -> int:
 def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, aa: str = "ssaa",
            pattern: str = "auto", seed: int = 0, threads: int = 0, clear_color: Any = None,
            keep_samples: bool = False, depth: bool = True, derivatives: str = "analytic",
-           debug_view: str = "none") -> RenderResult:
+           debug_view: str = "none", resolve_filter: str = "box") -> RenderResult:
     """Renders ``scene`` through ``camera`` into a ``width`` × ``height`` image.
 
     Args:
@@ -128,6 +129,11 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             quad, as GPUs do).
         debug_view: ``"none"``, ``"mip-level"`` (textured draws show a colour per mip level,
             blended for fractional levels) or ``"uv"`` (textured draws show fract(u), fract(v)).
+        resolve_filter: how samples become pixels: ``"box"`` (the mean of the pixel's own samples) or
+            a wider reconstruction filter of :func:`mipraster.resample` (``"tent"``, ``"mitchell"``,
+            ``"catmull-rom"``, ``"lanczos3"``; radius in pixels) that weighs the samples of the
+            pixels around it too: for a grid pattern, the same as resampling the image of the
+            samples to the output size with that filter. One sample per pixel runs no resolve.
 
     Returns:
         A :class:`RenderResult`.
@@ -154,6 +160,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     depth_output = _checks.flag(depth, "depth")
     derivative_mode = _checks.choice(derivatives, "derivatives", DERIVATIVES)
     debug = _checks.choice(debug_view, "debug_view", DEBUG_VIEWS)
+    resolve = _checks.choice(resolve_filter, "resolve_filter", {f: f for f in RESAMPLE_FILTERS})
     if clear_color is None:
         clear_color = scene.clear_color if scene.clear_color is not None else (0.0, 0.0, 0.0, 0.0)
     clear = _checks.rgba(clear_color, "clear_color")
@@ -169,4 +176,5 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     settings.threads, settings.clear_color, settings.keep_samples = n_threads, clear, keep
     settings.depth_output = depth_output
     settings.derivatives, settings.debug_view = derivative_mode, debug
+    settings.resolve_filter = resolve
     return RenderResult(_core.render(draws, core_camera, settings))

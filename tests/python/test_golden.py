@@ -225,6 +225,7 @@ def test_every_golden_has_a_test_and_a_readme_entry():
     expected = {"aa_1spp", "aa_msaa4_rotated", "aa_ssaa16_grid", "interp_flat", "interp_screen",
                 "interp_perspective", "blend_replace", "blend_add", "blend_over", "clip_near",
                 "depth_intersect", "demo", "plane_mip_levels"} | {f"plane_{f}" for f in PLANE_FILTERS}
+    expected |= {f"synth_{kind}" for kind in ("bricks", "pebbles", "sample_bricks", "sample_pebbles")}  # test_synthesis.py
     stray = {n for n in names if n.endswith((".actual", ".expected", ".diff"))}
     assert names - stray == expected
     readme = (GOLDEN_DIR / "README.md").read_text()

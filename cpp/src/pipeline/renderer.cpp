@@ -329,8 +329,11 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     const int S = settings.samples;
     const float clear_depth = camera.depth_convention == DepthConvention::opengl ? 1.0f : 0.0f;
     const glm::vec4 clear_depth4(clear_depth);
+    // A wide resolve filter reads neighbouring pixels (across tiles): it needs every sample kept.
+    const bool wide_resolve = settings.resolve_filter != ResolveFilter::box && S > 1;
+    const bool whole_frame = settings.keep_samples || wide_resolve;
     Framebuffer kept;
-    if (settings.keep_samples)
+    if (whole_frame)
         kept = make_framebuffer(settings.width, settings.height, S, settings.clear_color, needs_depth, clear_depth);
     result.color = Image(settings.width, settings.height, 4);
     if (depth_output) result.depth = Image(settings.width, settings.height, 1);
@@ -359,7 +362,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         TileTarget target = tile_target(grid, tile, result.pattern);
         // Tile-local storage, reused by each worker thread from tile to tile.
         thread_local std::vector<float> tile_color, tile_depth;
-        if (settings.keep_samples) {
+        if (whole_frame) {
             target.color = color_window(kept);
             target.depth = depth_window(kept);
         } else {
@@ -377,7 +380,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             }
         }
         rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
-        if (settings.keep_samples || S > 1)
+        if ((settings.keep_samples || S > 1) && !wide_resolve)
             resolve_tile(target.color, target.x0, target.y0, target.x1, target.y1, settings.resolve_filter, result.color);
         if (depth_output)
             resolve_view_depth(target.depth, target.x0, target.y0, target.x1, target.y1, clear_depth, decoder,
@@ -387,6 +390,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             settings.progress(++tiles_done, static_cast<std::size_t>(grid.count()));
         }
     });
+    if (wide_resolve) resolve_framebuffer(kept, result.pattern, settings.resolve_filter, pool, result.color);
     add_counters(tile_counters, stats);
     if (settings.keep_samples) result.framebuffer = std::move(kept);
     stats.raster_ms = ms_since(t0);

@@ -1,18 +1,27 @@
 #include "mipraster/pipeline/resolve.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
+#include <vector>
 
+#include "mipraster/core/constants.hpp"
 
 namespace mipraster {
 
-std::string to_string(ResolveFilter) { return "box"; }
-
 ResolveFilter parse_resolve_filter(const std::string& name) {
-    if (name == "box") return ResolveFilter::box;
-    throw std::invalid_argument("resolve filter: unknown name '" + name + "'; expected box");
+    try {
+        return parse_reconstruction_filter(name);
+    } catch (const std::invalid_argument&) {
+        throw std::invalid_argument("resolve filter: unknown name '" + name + "'; expected one of " +
+                                    reconstruction_filter_names());
+    }
 }
 
-void resolve_tile(const SampleWindow& samples, int x0, int y0, int x1, int y1, ResolveFilter, Image& out) {
+void resolve_tile(const SampleWindow& samples, int x0, int y0, int x1, int y1, ResolveFilter filter, Image& out) {
+    if (filter != ResolveFilter::box)
+        throw std::invalid_argument("resolve_tile: the " + to_string(filter) +
+                                    " filter reads neighbouring pixels; use resolve_framebuffer");
     const int S = samples.samples;
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
@@ -24,6 +33,102 @@ void resolve_tile(const SampleWindow& samples, int x0, int y0, int x1, int y1, R
                 for (int c = 0; c < 4; ++c) sum[c] += src[4 * s + c];
             for (int c = 0; c < 4; ++c) out.at(x, y, c) = static_cast<float>(sum[c] / S);
         }
+}
+
+namespace {
+
+// The 1-D weights of one axis: tap n ∈ [−reach, reach] (a neighbouring pixel) and sample s sit at
+// n + offset_s − ½ pixels from the pixel's centre.
+struct AxisTaps {
+    int reach = 0;
+    int samples = 0;
+    std::vector<float> weights;  // [(n + reach)·S + s]
+
+    float at(int n, int s) const { return weights[static_cast<std::size_t>(n + reach) * samples + s]; }
+};
+
+AxisTaps axis_taps(ResolveFilter filter, const std::vector<std::int32_t>& offsets) {
+    AxisTaps a;
+    a.samples = static_cast<int>(offsets.size());
+    a.reach = static_cast<int>(std::ceil(filter_radius(filter))) + 1;
+    a.weights.resize(static_cast<std::size_t>(2 * a.reach + 1) * a.samples);
+    for (int n = -a.reach; n <= a.reach; ++n)
+        for (int s = 0; s < a.samples; ++s)
+            a.weights[static_cast<std::size_t>(n + a.reach) * a.samples + s] = static_cast<float>(
+                filter_weight(filter, n + offsets[static_cast<std::size_t>(s)] / double(kSubpixelOne) - 0.5));
+    return a;
+}
+
+// Rows per parallel task: a few rows of W·S samples each, enough to hide the pool's hand-off.
+constexpr int kResolveRowsPerTask = 8;
+static_assert(kResolveRowsPerTask >= 1, "a task holds at least one row");
+
+}  // namespace
+
+void resolve_framebuffer(const Framebuffer& fb, const SamplePattern& pattern, ResolveFilter filter, ThreadPool& pool,
+                         Image& out) {
+    const int W = fb.width, H = fb.height, S = fb.samples;
+    if (pattern.count() != S)
+        throw std::invalid_argument("resolve_framebuffer: the pattern has " + std::to_string(pattern.count()) +
+                                    " samples, the framebuffer " + std::to_string(S));
+    if (out.width != W || out.height != H || out.channels != 4) out = Image(W, H, 4);
+    const AxisTaps tx = axis_taps(filter, pattern.x), ty = axis_taps(filter, pattern.y);
+    const std::size_t tasks = static_cast<std::size_t>((H + kResolveRowsPerTask - 1) / kResolveRowsPerTask);
+    auto rows_of = [&](std::size_t t) {
+        return std::pair<int, int>(static_cast<int>(t) * kResolveRowsPerTask,
+                                   std::min(H, static_cast<int>(t + 1) * kResolveRowsPerTask));
+    };
+
+    // Pass 1, along rows: per pixel and sample s, the sum over the neighbouring pixels of the
+    // x-weight times sample s's colour, and (per column and sample) the sum of the x-weights
+    // inside the frame.
+    std::vector<float> row_sums(fb.color.size());
+    std::vector<float> x_weight(static_cast<std::size_t>(W) * S, 0.0f);
+    for (int x = 0; x < W; ++x)
+        for (int n = std::max(-tx.reach, -x); n <= std::min(tx.reach, W - 1 - x); ++n)
+            for (int s = 0; s < S; ++s) x_weight[static_cast<std::size_t>(x) * S + s] += tx.at(n, s);
+    pool.parallel_for(tasks, [&](std::size_t t) {
+        const auto [y0, y1] = rows_of(t);
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < W; ++x) {
+                float* dst = &row_sums[fb.sample_index(x, y, 0) * 4];
+                for (int n = std::max(-tx.reach, -x); n <= std::min(tx.reach, W - 1 - x); ++n) {
+                    const float* src = &fb.color[fb.sample_index(x + n, y, 0) * 4];
+                    for (int s = 0; s < S; ++s) {
+                        const float w = tx.at(n, s);
+                        for (int c = 0; c < 4; ++c) dst[4 * s + c] += w * src[4 * s + c];
+                    }
+                }
+            }
+    });
+
+    // Pass 2, along columns: the y-weighted sums over the neighbouring rows and every sample,
+    // divided by the total weight of the samples inside the frame.
+    pool.parallel_for(tasks, [&](std::size_t t) {
+        const auto [y0, y1] = rows_of(t);
+        std::vector<float> y_weight(static_cast<std::size_t>(S));
+        for (int y = y0; y < y1; ++y) {
+            const int n0 = std::max(-ty.reach, -y), n1 = std::min(ty.reach, H - 1 - y);
+            for (int s = 0; s < S; ++s) {
+                y_weight[static_cast<std::size_t>(s)] = 0.0f;
+                for (int n = n0; n <= n1; ++n) y_weight[static_cast<std::size_t>(s)] += ty.at(n, s);
+            }
+            for (int x = 0; x < W; ++x) {
+                float acc[4] = {0, 0, 0, 0};
+                for (int n = n0; n <= n1; ++n) {
+                    const float* src = &row_sums[fb.sample_index(x, y + n, 0) * 4];
+                    for (int s = 0; s < S; ++s) {
+                        const float w = ty.at(n, s);
+                        for (int c = 0; c < 4; ++c) acc[c] += w * src[4 * s + c];
+                    }
+                }
+                float total = 0.0f;
+                for (int s = 0; s < S; ++s)
+                    total += x_weight[static_cast<std::size_t>(x) * S + s] * y_weight[static_cast<std::size_t>(s)];
+                for (int c = 0; c < 4; ++c) out.at(x, y, c) = acc[c] / total;
+            }
+        }
+    });
 }
 
 }  // namespace mipraster

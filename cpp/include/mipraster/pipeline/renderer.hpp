@@ -33,6 +33,9 @@ struct RenderSettings {
     AntiAliasing anti_aliasing = AntiAliasing::ssaa;
     int threads = 0;                                ///< 0 = all hardware threads
     glm::vec4 clear_color{0.0f};                    ///< premultiplied linear RGBA
+    /// box: the mean of each pixel's samples (tile by tile); others (tent, mitchell, catmull-rom,
+    /// lanczos3) weigh the samples of the pixels around it (see resolve_framebuffer). One sample per
+    /// pixel runs no resolve whatever the filter.
     ResolveFilter resolve_filter = ResolveFilter::box;
     bool keep_samples = false;                      ///< return the supersample framebuffer too
     bool depth_output = false;                      ///< return RenderResult::depth (when some draw tests depth)
