@@ -48,6 +48,11 @@ constexpr const char* kUsage =
     "             (a textured cube on a textured checker plane to the horizon):\n"
     "             mipraster render [SCENE] -o OUT [options]\n"
     "  compare    compare two images value by value and print a report (idiff style)\n"
+    "  study      error against run time of the quality knobs (samples, pattern, SSAA/MSAA,\n"
+    "             texture filter, anisotropy, LOD bias): CSV, Markdown table and plot. It runs in\n"
+    "             Python: the binary hands its arguments to `python3 -m mipraster.study` (the\n"
+    "             python3 beside this binary, else $MIPRASTER_PYTHON, else the one on PATH);\n"
+    "             mipraster study --help lists its options\n"
     "\n"
     "render options:\n"
     "  -o, --output PATH     output image: .png (sRGB 8-bit) or .exr (linear float)  [required]\n"
@@ -69,7 +74,8 @@ constexpr const char* kUsage =
     "  --lod-bias B          added to the level of detail (log2 texels per pixel)\n"
     "  --debug-view V        none, mip-level (a colour per mip level), uv (uv as colour)\n"
     "  --derivatives D       analytic (exact per sample) or quad (2x2 finite differences) [analytic]\n"
-    "  --stats               print triangle, sample and per-stage time counts\n"
+    "  --stats               print triangle, sample and per-stage time counts, and (spp >= 2)\n"
+    "                        the estimated RMSE from two interleaved halves of the samples\n"
     "  --stats-json PATH     write the counts and times as JSON (- = stdout)\n"
     "  --quiet               print nothing but errors (no summary, no progress bar)\n"
     "\n"
@@ -305,13 +311,22 @@ int run_render(const std::vector<std::string>& args) {
     if (sampler_flags && !o.quiet && std::none_of(draws.begin(), draws.end(), [](const Draw& d) { return bool(d.texture); }))
         std::fprintf(stderr, "mipraster: warning: the scene has no textured draw; the texture options change nothing\n");
     if (!o.quiet && isatty(STDOUT_FILENO)) settings.progress = draw_progress;
+    settings.estimate_error = o.print_stats && settings.samples >= 2;
     const RenderResult result = render(draws, camera, settings);
     write_image(o.output, result.color);
     if (!o.quiet)
         std::printf("wrote %s (%dx%d, %d spp %s, %.1f ms on %d threads)\n", o.output.c_str(), settings.width,
                     settings.height, settings.samples, to_string(settings.anti_aliasing).c_str(), result.stats.total_ms,
                     result.stats.threads);
-    if (o.print_stats) std::printf("%s\n%s\n", result.pattern.to_string().c_str(), result.stats.to_string().c_str());
+    if (o.print_stats) {
+        std::printf("%s\n%s\n", result.pattern.to_string().c_str(), result.stats.to_string().c_str());
+        if (settings.estimate_error)
+            std::printf("error estimate (linear RGB, from two interleaved halves of the samples; sampling error "
+                        "only, not filter blur): rmse=%.6g, worst pixel=%.6g\n",
+                        result.error_estimate.rmse, result.error_estimate.max_pixel);
+        else
+            std::printf("error estimate: needs --spp 2 or more\n");
+    }
     if (o.stats_json == "-") {
         std::printf("%s\n", result.stats.to_json().c_str());
     } else if (!o.stats_json.empty()) {
@@ -352,6 +367,35 @@ int run_compare(const std::vector<std::string>& args) {
     return report.passed ? 0 : 1;
 }
 
+// Where `mipraster study` finds Python: the python3 beside this binary (a virtual environment's
+// bin/), else $MIPRASTER_PYTHON, else python3 on PATH.
+std::string python_executable() {
+    char self[4096];
+    const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n > 0) {
+        std::string dir(self, static_cast<std::size_t>(n));
+        dir = dir.substr(0, dir.find_last_of('/'));
+        const std::string beside = dir + "/python3";
+        if (access(beside.c_str(), X_OK) == 0) return beside;
+    }
+    if (const char* env = std::getenv("MIPRASTER_PYTHON"); env && *env) return env;
+    return "python3";
+}
+
+// Hands a subcommand whose home is the Python package to `python3 -m MODULE ARGS...`.
+int run_python_module(const std::string& module, const std::vector<std::string>& args) {
+    const std::string python = python_executable();
+    std::vector<std::string> words = {python, "-m", module};
+    words.insert(words.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    execvp(python.c_str(), argv.data());
+    std::fprintf(stderr, "mipraster: error: this command runs in Python (%s -m %s) and %s could not be started: %s\n",
+                 python.c_str(), module.c_str(), python.c_str(), std::strerror(errno));
+    return 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -368,6 +412,7 @@ int main(int argc, char** argv) {
         }
         if (args[0] == "render") return run_render({args.begin() + 1, args.end()});
         if (args[0] == "compare") return run_compare({args.begin() + 1, args.end()});
+        if (args[0] == "study") return run_python_module("mipraster.study", {args.begin() + 1, args.end()});
         throw UsageError("unknown command '" + args[0] + "'");
     } catch (const UsageError& e) {
         std::fprintf(stderr, "mipraster: %s\n\n%s", e.what(), kUsage);
