@@ -34,6 +34,11 @@ Image files (:func:`read_image`, :func:`write_image`, :meth:`RenderResult.save`)
 :func:`load_scene` reads OBJ and glTF scene files (geometry, colours, uvs, normals, base-colour
 textures with their samplers, cameras) through the same module.
 
+:func:`render` can estimate its own error (``estimate_error=True``: ``result.error_map``,
+``result.error_estimate``) and spend samples adaptively (``target_error=e``). The error-against-time
+study is :func:`mipraster.study.study` (``python -m mipraster.study``, ``mipraster study``); its
+ground truths are in :mod:`mipraster.reference` and its scenes in :mod:`mipraster.study_scenes`.
+
 :func:`compare` compares two images value by value with thresholds (OpenImageIO ``idiff`` style) and
 returns a :class:`CompareReport`; :mod:`mipraster.testing` (imported explicitly) builds golden-image
 tests on it.
