@@ -1,10 +1,14 @@
-"""Adaptive quality: more samples only on the tiles whose estimated error is above a target.
+"""Adaptive quality: more samples only on the tiles whose estimated error needs them.
 
-A first pass renders every tile at the requested samples per pixel with the error estimate on
-(two interleaved halves of each pixel's samples; see :func:`mipraster.render`). Each 32×32 tile
-whose estimated RMSE exceeds the target is rendered again at 4× the samples (the renderer's tile
-mask skips all other tiles), and so on up to 64 samples. A tile that meets the target keeps its
-pixels, so the estimate of the whole image meets it too once every tile does (or has 64 samples).
+A first pass renders every tile at the requested samples per pixel S₀ with the error estimate on
+(two interleaved halves of each pixel's samples; see :func:`mipraster.render`). With error ∝ 1/√S,
+tile t's variance v_t = e_t²·S_t is known, and the fewest samples that bring the image's estimated
+RMSE to the target T are S'_t = √v_t·Σ_u √v_u / (N·T²) (minimize Σ S'_t subject to
+Σ v_t/S'_t ≤ N·T², N tiles). Each tile that needs more than it has is rendered again with S'_t
+rounded up to S₀·2^k (at most 64); tiles that need the same count share one pass (the renderer's
+tile mask skips all others). The estimate is measured again and the rounds go on until the image's
+estimate meets the target or every tile with any error has 64 samples. Tiles with no estimated error
+(nothing but flat colour) are never rendered again.
 """
 from __future__ import annotations
 
@@ -17,8 +21,6 @@ from . import _checks, _core
 
 __all__ = ["tile_rmse", "render_adaptive_settings"]
 
-# Each refinement quadruples the samples (halves the standard error of independent samples).
-_REFINE_FACTOR = 4
 
 
 def tile_rmse(error_map: np.ndarray, tile: int = _core.TILE_SIZE) -> np.ndarray:
@@ -53,28 +55,47 @@ def render_adaptive_settings(draws: List[Any], camera: Any, settings: Any, targe
     stats = dict(raw["stats"])
     tile = _core.TILE_SIZE
     per_tile = tile_rmse(error_map, tile)
-    spp = settings.samples
-    tile_spp = np.full(per_tile.shape, spp, dtype=np.int64)
-    while spp < _core.MAX_SAMPLES:
-        refine = per_tile > target
-        if not refine.any():
+    base = settings.samples
+    tile_spp = np.full(per_tile.shape, base, dtype=np.int64)
+    count = np.ones_like(per_tile)  # pixels per tile, for the image's mean
+    count[:] = np.bincount((np.arange(color.shape[0])[:, None] // tile * per_tile.shape[1]
+                            + np.arange(color.shape[1])[None, :] // tile).ravel(),
+                           minlength=per_tile.size).reshape(per_tile.shape)
+    while True:
+        image_mse = float((per_tile ** 2 * count).sum() / count.sum())
+        open_tiles = (per_tile > 0) & (tile_spp < _core.MAX_SAMPLES)
+        if image_mse <= target * target or not open_tiles.any():
             break
-        spp = min(_core.MAX_SAMPLES, spp * _REFINE_FACTOR)
-        settings.samples = spp
-        settings.tile_mask = refine.astype(np.uint8).ravel().tolist()
-        again = _core.render(draws, camera, settings)
-        for ty, tx in zip(*np.nonzero(refine)):
-            rows = slice(ty * tile, (ty + 1) * tile)
-            cols = slice(tx * tile, (tx + 1) * tile)
-            color[rows, cols] = again["color"][rows, cols]
-            error_map[rows, cols] = again["error_map"][rows, cols]
-            if depth is not None and again["depth"] is not None:
-                depth[rows, cols] = again["depth"][rows, cols]
-        for key, value in again["stats"].items():
-            if key != "threads":
-                stats[key] += value
-        per_tile = np.where(refine, tile_rmse(error_map, tile), per_tile)
-        tile_spp[refine] = spp
+        # The optimal allocation for the image's mean squared error (see the module docstring).
+        sd = per_tile * np.sqrt(tile_spp) * np.sqrt(count)
+        need = sd / np.sqrt(count) * sd.sum() / (count.sum() * target * target)
+        steps = np.ceil(np.log2(np.maximum(need / base, 1.0)) - 1e-9).astype(np.int64)
+        wanted = np.minimum(_core.MAX_SAMPLES, base * 2 ** np.minimum(steps, 6))
+        wanted = np.where(open_tiles & (wanted > tile_spp), wanted, tile_spp)
+        if (wanted == tile_spp).all():  # rounding left nothing to do: the worst tile goes up a step
+            worst = np.unravel_index(np.argmax(np.where(open_tiles, per_tile ** 2 * count, -1.0)), per_tile.shape)
+            wanted[worst] = min(_core.MAX_SAMPLES, 2 * tile_spp[worst])
+        todo = wanted > tile_spp
+        if settings.pattern == _core.PatternKind.rotated:
+            settings.pattern = _core.PatternKind.grid  # the rotated pattern has 4 samples only
+        for spp in sorted(set(wanted[todo].tolist())):
+            group = todo & (wanted == spp)
+            settings.samples = int(spp)
+            settings.tile_mask = group.astype(np.uint8).ravel().tolist()
+            again = _core.render(draws, camera, settings)
+            for ty, tx in zip(*np.nonzero(group)):
+                rows = slice(ty * tile, (ty + 1) * tile)
+                cols = slice(tx * tile, (tx + 1) * tile)
+                color[rows, cols] = again["color"][rows, cols]
+                error_map[rows, cols] = again["error_map"][rows, cols]
+                if depth is not None and again["depth"] is not None:
+                    depth[rows, cols] = again["depth"][rows, cols]
+            for key, value in again["stats"].items():
+                if key != "threads":
+                    stats[key] += value
+            tile_spp[group] = spp
+        per_tile = np.where(todo, tile_rmse(error_map, tile), per_tile)
+    settings.samples = base
     raw["color"], raw["error_map"], raw["depth"], raw["stats"] = color, error_map, depth, stats
     raw["error_estimate"] = float(np.sqrt(np.mean(np.asarray(error_map, dtype=np.float64) ** 2)))
     raw["tile_spp"] = tile_spp

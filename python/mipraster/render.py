@@ -149,9 +149,11 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             texture detail between samples), not error that every sample shares (a blurring
             texture filter; MSAA's one shade per pixel). Needs ``spp >= 2``. Fills
             ``error_map`` and ``error_estimate``.
-        target_error: adaptive quality: render at ``spp`` (at least 2), then re-render each 32×32
-            tile whose estimated RMSE exceeds ``target_error`` at 4× the samples, up to 64, until
-            every tile meets it or has 64 (see :func:`mipraster.adaptive.render_adaptive`).
+        target_error: adaptive quality: render at ``spp`` (at least 2), then re-render the 32×32
+            tiles whose estimated error needs it with the samples the estimate says they need
+            (error ∝ 1/√spp; the fewest samples for the image's estimated RMSE), up to 64, until
+            the image's estimate meets ``target_error`` (an RMSE in linear colour) or every tile
+            with any error has 64 (see :mod:`mipraster.adaptive`).
             ``stats['total_ms']`` is the time of all passes; ``tile_spp`` shows where samples went.
 
     Returns:

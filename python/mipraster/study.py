@@ -134,9 +134,9 @@ def _median_ms(fn, repeats: int) -> float:
 
 
 def _uniform_time_for_error(rows: List[StudyRow], scene: str, error: float) -> Optional[float]:
-    """Time (all threads) uniform SSAA needs for ``error``: log-log interpolation between the
+    """Time (one thread) uniform SSAA needs for ``error``: log-log interpolation between the
     bracketing uniform renders (auto pattern, the scene's filter); None when 64 spp does not reach it."""
-    pts = sorted((r.spp, r.ms_all_threads, r.rmse) for r in rows
+    pts = sorted((r.spp, r.ms_one_thread, r.rmse) for r in rows
                  if r.scene == scene and r.renderer == "mipraster" and r.label == f"{r.spp}x" and r.spp in UNIFORM_FAMILY)
     for (s0, t0, e0), (s1, t1, e1) in zip(pts, pts[1:]):
         if e0 >= error >= e1 and e0 > 0 and e1 > 0:
@@ -200,8 +200,8 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
             if uniform is None:
                 row.notes = "uniform SSAA up to 64x does not reach this error"
             else:
-                row.notes = (f"uniform SSAA needs {uniform:.2f} ms for this error: "
-                             f"{100 * (1 - row.ms_all_threads / uniform):.0f}% saved")
+                row.notes = (f"uniform SSAA needs {uniform:.2f} ms (one thread) for this error: "
+                             f"{100 * (1 - row.ms_one_thread / uniform):.0f}% saved")
     return rows
 
 
@@ -253,9 +253,9 @@ def markdown(rows: Sequence[StudyRow], notes: Sequence[str]) -> str:
     out = ["# Error against run time", ""] + [f"- {n}" for n in notes] + [""]
     for scene in dict.fromkeys(r.scene for r in rows):
         rs = [r for r in rows if r.scene == scene]
-        front = set(pareto([(r.ms_all_threads, r.rmse) for r in rs]))
+        front = set(pareto([(r.ms_one_thread, r.rmse) for r in rs]))
         out += [f"## {scene}", "", f"Reference residual (its own estimated RMSE): {_fmt(rs[0].reference_residual)}", "",
-                "| configuration | filter | ms (1 thread) | ms (all) | RMSE | mean abs | max abs | estimate | est/true | Pareto |",
+                "| configuration | filter | ms (1 thread) | ms (all) | RMSE | mean abs | max abs | estimate | est/true | Pareto (1 thread) |",
                 "|---|---|---:|---:|---:|---:|---:|---:|---:|:-:|"]
         for i, r in enumerate(rs):
             label = r.label + (f" (mean {r.mean_spp:.1f} spp)" if not math.isnan(r.mean_spp) else "")
@@ -278,13 +278,18 @@ def markdown(rows: Sequence[StudyRow], notes: Sequence[str]) -> str:
     if adaptive:
         out += ["## Adaptive quality", ""]
         out += [f"- {r.scene} {r.label}: target {r.target_error:.3g}, estimate {_fmt(r.estimate)}, true RMSE "
-                f"{r.rmse:.4g}, {r.ms_all_threads:.2f} ms, mean {r.mean_spp:.1f} spp; {r.notes}" for r in adaptive]
+                f"{r.rmse:.4g}, {r.ms_one_thread:.2f} ms (one thread), mean {r.mean_spp:.1f} spp; {r.notes}" for r in adaptive]
         out.append("")
     return "\n".join(out)
 
 
-def plot(rows: Sequence[StudyRow], path: str, dpi: int = 100) -> Optional[str]:
-    """Error against time (all threads), log-log, one panel per scene; returns None or why it could not."""
+def plot(rows: Sequence[StudyRow], path: str, dpi: int = 80, time: str = "one") -> Optional[str]:
+    """Error against time, log-log, one panel per scene; returns None or why it could not.
+
+    ``time`` is ``"one"`` (the one-thread median, steadier on a shared machine) or ``"all"``."""
+    if time not in ("one", "all"):
+        raise ValueError(f"time: expected 'one' or 'all', got {time!r}")
+    attr = "ms_one_thread" if time == "one" else "ms_all_threads"
     try:
         import matplotlib
 
@@ -300,17 +305,17 @@ def plot(rows: Sequence[StudyRow], path: str, dpi: int = 100) -> Optional[str]:
         for kind, (marker, colour) in styles.items():
             pts = [r for r in rs if r.renderer == kind]
             if pts:
-                ax.scatter([r.ms_all_threads for r in pts], [r.rmse for r in pts], marker=marker, color=colour,
+                ax.scatter([getattr(r, attr) for r in pts], [r.rmse for r in pts], marker=marker, color=colour,
                            s=60 if marker == "*" else 22, label=kind, zorder=3)
-        front = pareto([(r.ms_all_threads, r.rmse) for r in rs])
-        ax.step([rs[i].ms_all_threads for i in front], [rs[i].rmse for i in front], where="post", color="black",
+        front = pareto([(getattr(r, attr), r.rmse) for r in rs])
+        ax.step([getattr(rs[i], attr) for i in front], [rs[i].rmse for i in front], where="post", color="black",
                 lw=1, alpha=0.6, label="Pareto frontier", zorder=2)
         for r in rs:
-            ax.annotate(r.label, (r.ms_all_threads, r.rmse), fontsize=5.5, xytext=(3, 2), textcoords="offset points")
+            ax.annotate(r.label, (getattr(r, attr), r.rmse), fontsize=5.5, xytext=(3, 2), textcoords="offset points")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_title(f"{scene} (residual of reference {rs[0].reference_residual:.1e})" if rs else scene, fontsize=9)
-        ax.set_xlabel("ms per frame (median, all threads)", fontsize=8)
+        ax.set_xlabel(f"ms per frame (median, {'one thread' if time == 'one' else 'all threads'})", fontsize=8)
         ax.set_ylabel("RMSE vs reference (linear RGB)", fontsize=8)
         ax.tick_params(labelsize=7)
         ax.grid(True, which="both", alpha=0.2)

@@ -8,7 +8,7 @@ import pytest
 import mipraster as mr
 from mipraster import _core
 from mipraster.adaptive import tile_rmse
-from mipraster.reference import image_error
+from mipraster.reference import exact_coverage, image_error
 from mipraster.study_scenes import checker_plane, star, with_filter
 
 
@@ -64,27 +64,44 @@ def test_estimate_calibration(make, spp, pattern):
     assert 0.5 <= r.error_estimate / true <= 2.0, (r.error_estimate, true)
 
 
-def test_adaptive_refines_only_where_needed():
-    s = star(96, 64)
-    ref, _, _ = s.reference()
-    base = mr.render(s.scene, s.camera, 96, 64, spp=4, estimate_error=True)
+def _corner_triangle(width, height):
+    # One triangle in the top-left tile (pixel coordinates, as the study's star): every other tile
+    # is flat background with no error.
+    tri = np.array([[(3.0, 4.0), (27.0, 9.0), (9.0, 26.0)]])
+    mesh = mr.Mesh(np.c_[tri[0], np.zeros(3)] * [1, -1, 1], [[0, 1, 2]], colors=np.ones((3, 3)))
+    scene = mr.Scene()
+    scene.add(mesh, depth_test=False)
+    camera = mr.Camera.orthographic(eye=(width / 2, -height / 2, 1.0), target=(width / 2, -height / 2, 0.0),
+                                    height=float(height), near=0.0, far=2.0)
+    return scene, camera, exact_coverage(tri, np.ones((1, 3)), width, height, (0.0, 0.0, 0.0))
+
+
+@pytest.mark.parametrize("spp, pattern", [(4, "auto"), (4, "stratified"), (2, "auto")])
+def test_adaptive_refines_only_where_needed(spp, pattern):
+    scene, camera, ref = _corner_triangle(96, 64)
+    clear = (0.0, 0.0, 0.0, 1.0)
+    base = mr.render(scene, camera, 96, 64, spp=spp, pattern=pattern, estimate_error=True, clear_color=clear)
+    assert image_error(base.color, ref)["rmse"] > 0
     target = base.error_estimate / 3
-    r = mr.render(s.scene, s.camera, 96, 64, spp=4, target_error=target)
-    per_tile = tile_rmse(r.error_map)
-    assert r.tile_spp.shape == per_tile.shape == (2, 3)
-    # Every tile meets the target or has the most samples.
-    assert np.all((per_tile <= target) | (r.tile_spp == _core.MAX_SAMPLES))
-    assert r.error_estimate <= target or np.any(r.tile_spp == _core.MAX_SAMPLES)
-    # Tiles the base render already estimated under the target were not re-rendered: same pixels.
-    calm = tile_rmse(base.error_map) <= target
+    r = mr.render(scene, camera, 96, 64, spp=spp, pattern=pattern, target_error=target, clear_color=clear)
+    assert r.tile_spp.shape == (2, 3)
+    # The image's estimate meets the target, or the tile with the edges has run out of samples.
+    assert r.error_estimate <= target or r.tile_spp[0, 0] == _core.MAX_SAMPLES
+    assert r.tile_spp[0, 0] > spp
+    # The flat tiles were not rendered again: base samples, the base render's pixels.
     t = _core.TILE_SIZE
-    for ty, tx in zip(*np.nonzero(calm)):
-        assert r.tile_spp[ty, tx] == 4
+    for ty, tx in [(0, 1), (0, 2), (1, 0), (1, 1), (1, 2)]:
+        assert r.tile_spp[ty, tx] == spp
         np.testing.assert_array_equal(r.color[ty * t:(ty + 1) * t, tx * t:(tx + 1) * t],
                                       base.color[ty * t:(ty + 1) * t, tx * t:(tx + 1) * t])
-    assert np.any(r.tile_spp > 4)
     # And the true error went down.
     assert image_error(r.color, ref)["rmse"] < image_error(base.color, ref)["rmse"]
+
+
+def test_adaptive_unreachable_target_stops_at_64():
+    scene, camera, _ = _corner_triangle(64, 32)
+    r = mr.render(scene, camera, 64, 32, spp=4, target_error=1e-9)
+    assert r.tile_spp.tolist() == [[_core.MAX_SAMPLES, 4]]
 
 
 def test_adaptive_bad_input():
