@@ -124,15 +124,6 @@ def tiny_sweep(textured: bool) -> List[Knobs]:
 UNIFORM_FAMILY = (2, 4, 8, 16, 32, 64)  # what adaptive renders are compared with (same patterns, SSAA)
 
 
-def _median_ms(fn, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append((time.perf_counter() - t0) * 1000.0)
-    return statistics.median(times)
-
-
 def _uniform_time_for_error(rows: List[StudyRow], scene: str, error: float) -> Optional[float]:
     """Time (one thread) uniform SSAA needs for ``error``: log-log interpolation between the
     bracketing uniform renders (auto pattern, the scene's filter); None when 64 spp does not reach it."""
@@ -155,6 +146,7 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
     ref, residual, kind = s.reference(reference_quality)
     log(f"  reference: {kind}; its own estimated RMSE {residual:.2e} ({time.perf_counter() - t0:.1f} s)")
     rows: List[StudyRow] = []
+    runs = []
     estimate4 = None
     for k in sweep:
         scene = with_filter(s.scene, k.filter, k.max_anisotropy, k.lod_bias) if (k.filter or k.max_anisotropy or
@@ -166,20 +158,20 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
             target = max(k.target_error * estimate4, 1e-6)
         kwargs = dict(spp=k.spp, aa=k.aa, pattern=k.pattern, depth=False, target_error=target)
 
-        def run(n_threads: int):
+        def run(n_threads: int, scene=scene, kwargs=kwargs):  # bound now: runs are timed after the loop
             return render(scene, s.camera, s.width, s.height, threads=n_threads, **kwargs)
 
         result = run(0)
         err = image_error(result.color, ref)
-        ms1 = _median_ms(lambda: run(1), repeats)
-        msn = _median_ms(lambda: run(threads), repeats)
+        runs.append(run)
         draws = [d for d in scene.draws if d.texture is not None]
         sampler = draws[0].sampler if draws else None
         row = StudyRow(scene=s.name, label=k.label, renderer="mipraster adaptive" if target else "mipraster",
                        spp=k.spp, pattern=result.pattern_kind, aa=k.aa,
                        filter=sampler.filter if sampler else "-",
                        max_anisotropy=sampler.max_anisotropy if sampler else float("nan"),
-                       lod_bias=sampler.lod_bias if sampler else float("nan"), ms_one_thread=ms1, ms_all_threads=msn,
+                       lod_bias=sampler.lod_bias if sampler else float("nan"), ms_one_thread=math.nan,
+                       ms_all_threads=math.nan,
                        threads=int(result.stats["threads"]) if threads == 0 else threads,
                        reference_residual=residual, **err)
         if target is not None:
@@ -192,7 +184,18 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
         if not math.isnan(row.estimate) and row.rmse > 0:
             row.estimate_ratio = row.estimate / row.rmse
         rows.append(row)
-        log(f"  {k.label:32s} {ms1:8.2f} ms x1 {msn:8.2f} ms xN  rmse {row.rmse:.4g}"
+    # Timing in rounds over all configurations, so that a burst of load elsewhere on the machine
+    # spreads over all of them instead of landing on one.
+    times: List[Dict[int, List[float]]] = [{1: [], threads: []} for _ in runs]
+    for _ in range(repeats):
+        for i, run in enumerate(runs):
+            for n in (1, threads):
+                t0 = time.perf_counter()
+                run(n)
+                times[i][n].append((time.perf_counter() - t0) * 1000.0)
+    for row, t in zip(rows, times):
+        row.ms_one_thread, row.ms_all_threads = statistics.median(t[1]), statistics.median(t[threads])
+        log(f"  {row.label:36s} {row.ms_one_thread:8.2f} ms x1 {row.ms_all_threads:8.2f} ms xN  rmse {row.rmse:.4g}"
             + (f"  est/true {row.estimate_ratio:.2f}" if not math.isnan(row.estimate_ratio) else ""))
     for row in rows:
         if row.renderer == "mipraster adaptive":
