@@ -72,9 +72,12 @@ def render_adaptive_settings(draws: List[Any], camera: Any, settings: Any, targe
         steps = np.ceil(np.log2(np.maximum(need / base, 1.0)) - 1e-9).astype(np.int64)
         wanted = np.minimum(_core.MAX_SAMPLES, base * 2 ** np.minimum(steps, 6))
         wanted = np.where(open_tiles & (wanted > tile_spp), wanted, tile_spp)
-        if (wanted == tile_spp).all():  # rounding left nothing to do: the worst tile goes up a step
-            worst = np.unravel_index(np.argmax(np.where(open_tiles, per_tile ** 2 * count, -1.0)), per_tile.shape)
-            wanted[worst] = min(_core.MAX_SAMPLES, 2 * tile_spp[worst])
+        if (wanted == tile_spp).all():
+            # The estimate is just above the target and rounding left nothing to do: double the
+            # samples of every open tile that holds more than its share of the squared error.
+            share = np.where(open_tiles, per_tile ** 2 * count, 0.0)
+            big = open_tiles & (share >= share[open_tiles].mean())
+            wanted = np.where(big, np.minimum(_core.MAX_SAMPLES, 2 * tile_spp), tile_spp)
         todo = wanted > tile_spp
         if settings.pattern == _core.PatternKind.rotated:
             settings.pattern = _core.PatternKind.grid  # the rotated pattern has 4 samples only
