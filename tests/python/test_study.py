@@ -104,3 +104,27 @@ def test_llvmpipe_says_why_or_renders():
     assert image.shape == (32, 48, 4) and ms > 0
     # llvmpipe's 4x MSAA of the same triangles is close to the exact coverage, not equal.
     assert 0 < st.image_error(image, ref)["rmse"] < 0.1
+
+
+def test_converged_reference_agrees_with_exact_coverage():
+    # The converged render (for scene files) against the exact coverage of the same star: within a
+    # factor 2 of its own stated residual (plus the 1/256 px vertex snapping, far smaller here).
+    from mipraster.reference import converged_reference, image_error
+
+    s = star(40, 30)
+    exact, _, _ = s.reference()
+    image, residual = converged_reference(s.scene, s.camera, 40, 30, clear_color=s.clear_color, upscale=2)
+    assert 0 < residual < 5e-3
+    assert image_error(image, exact)["rmse"] <= 2 * residual
+
+
+def test_study_of_a_scene_file(tmp_path):
+    path = tmp_path / "tri.obj"
+    path.write_text("v 0 0 0 1 0.5 0\nv 1 0 0 1 0.5 0\nv 0.2 1 0 1 0.5 0\nf 1 2 3\n")
+    rows = st.study(str(tmp_path / "out"), scenes=[], scene_files=[str(path)], width=32, height=24, repeats=1,
+                    tiny=True, llvmpipe=False, make_plot=False, reference_quality=0.25, log=lambda *_: None)
+    assert {r.scene for r in rows} == {"tri"}
+    assert len(rows) == len(st.tiny_sweep(False))
+    by = {r.label: r for r in rows}
+    assert by["16x"].rmse < by["1x"].rmse  # converged reference: more samples, closer
+    assert rows[0].reference_residual > 0
