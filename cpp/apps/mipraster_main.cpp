@@ -77,6 +77,8 @@ constexpr const char* kUsage =
     "  --stats               print triangle, sample and per-stage time counts, and (spp >= 2)\n"
     "                        the estimated RMSE from two interleaved halves of the samples\n"
     "  --stats-json PATH     write the counts and times as JSON (- = stdout)\n"
+    "  --error-map PATH      write the per-pixel error estimate (RMS over linear R, G, B from two\n"
+    "                        interleaved halves of the samples; .exr linear, .png sRGB grey); spp >= 2\n"
     "  --quiet               print nothing but errors (no summary, no progress bar)\n"
     "\n"
     "compare A B [options]: values are compared as read (linear float; 8-bit files are decoded\n"
@@ -140,6 +142,7 @@ struct RenderOptions {
     RenderSettings settings;
     bool print_stats = false;
     std::string stats_json;  ///< path, "-" for stdout, empty for none
+    std::string error_map;   ///< --error-map PATH: the per-pixel error estimate; empty for none
     bool quiet = false;
     std::vector<double> look_at;  ///< empty: the demo's camera
     double fov_degrees = 0.0;     ///< 0: the demo's
@@ -243,6 +246,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
             o.print_stats = true;
         } else if (a == "--stats-json") {
             o.stats_json = value();
+        } else if (a == "--error-map") {
+            o.error_map = value();
         } else if (a == "--quiet") {
             o.quiet = true;
         } else if (!a.empty() && a[0] != '-' && o.scene.empty()) {
@@ -256,6 +261,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     if (o.camera >= 0 && o.scene.empty())
         throw UsageError("--camera: needs a scene file (the built-in demo has one camera)");
     if (o.output.empty()) throw UsageError("render: missing -o PATH (where to write the image)");
+    if (!o.error_map.empty() && o.settings.samples < 2)
+        throw UsageError("--error-map: the estimate compares two halves of each pixel's samples; give --spp 2 or more");
     return o;
 }
 
@@ -311,13 +318,14 @@ int run_render(const std::vector<std::string>& args) {
     if (sampler_flags && !o.quiet && std::none_of(draws.begin(), draws.end(), [](const Draw& d) { return bool(d.texture); }))
         std::fprintf(stderr, "mipraster: warning: the scene has no textured draw; the texture options change nothing\n");
     if (!o.quiet && isatty(STDOUT_FILENO)) settings.progress = draw_progress;
-    settings.estimate_error = o.print_stats && settings.samples >= 2;
+    settings.estimate_error = (o.print_stats && settings.samples >= 2) || !o.error_map.empty();
     const RenderResult result = render(draws, camera, settings);
     write_image(o.output, result.color);
     if (!o.quiet)
         std::printf("wrote %s (%dx%d, %d spp %s, %.1f ms on %d threads)\n", o.output.c_str(), settings.width,
                     settings.height, settings.samples, to_string(settings.anti_aliasing).c_str(), result.stats.total_ms,
                     result.stats.threads);
+    if (!o.error_map.empty()) write_image(o.error_map, result.error_map);
     if (o.print_stats) {
         std::printf("%s\n%s\n", result.pattern.to_string().c_str(), result.stats.to_string().c_str());
         if (settings.estimate_error)

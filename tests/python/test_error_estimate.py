@@ -137,3 +137,22 @@ def test_cli_stats_prints_the_estimate(tmp_path):
     r = subprocess.run([EXE, "render", "-o", str(tmp_path / "b.png"), "--size", "64x36", "--spp", "1", "--stats"],
                        capture_output=True, text=True, timeout=120)
     assert "error estimate: needs --spp 2 or more" in r.stdout
+
+
+def test_cli_error_map(tmp_path):
+    # The map the CLI writes is the one render(..., estimate_error=True) returns for the same demo.
+    from test_cli import EXE
+    import subprocess
+
+    out = tmp_path / "err.exr"
+    r = subprocess.run([EXE, "render", "-o", str(tmp_path / "a.png"), "--size", "64x36", "--spp", "8", "--aa", "ssaa",
+                        "--error-map", str(out), "--quiet"], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    written = mr.read_image(out)
+    scene, camera = mr.Scene.demo()
+    expected = mr.render(scene, camera, 64, 36, spp=8, aa="ssaa", estimate_error=True).error_map
+    np.testing.assert_allclose(np.asarray(written).reshape(36, 64, -1)[..., 0], expected, atol=1e-6)
+    assert expected.max() > 0
+    r = subprocess.run([EXE, "render", "-o", str(tmp_path / "b.png"), "--spp", "1", "--error-map", str(out)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "--error-map" in r.stderr and "--spp 2" in r.stderr
