@@ -92,6 +92,12 @@ py::dict render_py(const py::sequence& draw_objects, const Camera& camera, const
     }
     out["depth"] = py::none();
     if (!result.depth.pixels.empty()) out["depth"] = vector_to_array(std::move(result.depth.pixels), {h, w});
+    out["error_map"] = py::none();
+    out["error_estimate"] = py::none();
+    if (settings.estimate_error) {
+        out["error_map"] = vector_to_array(std::move(result.error_map.pixels), {h, w});
+        out["error_estimate"] = result.error_estimate.rmse;
+    }
     out["pattern"] = pattern_offsets(result.pattern);
     out["pattern_kind"] = to_string(result.pattern.kind);
     out["stats"] = stats_dict(result.stats);
@@ -142,6 +148,7 @@ void bind_render(py::module_& m) {
     m.attr("MAX_SAMPLES") = kMaxSamples;
     m.attr("MAX_THREADS") = kMaxThreads;
     m.attr("SUBPIXEL_ONE") = kSubpixelOne;
+    m.attr("TILE_SIZE") = kTileSize;
 
     // --- settings -----------------------------------------------------------------------------------
     py::enum_<AntiAliasing>(m, "AntiAliasing", "SSAA shades every sample; MSAA once per pixel per triangle.")
@@ -185,6 +192,10 @@ void bind_render(py::module_& m) {
             "debug_view", [](const RenderSettings& s) { return to_string(s.debug_view); },
             [](RenderSettings& s, const std::string& name) { s.debug_view = parse_debug_view(name); },
             "'none', 'mip-level' or 'uv': replaces the texture lookup of textured draws")
+        .def_readwrite("estimate_error", &RenderSettings::estimate_error,
+                       "estimate the error from two interleaved halves of the samples (needs samples >= 2)")
+        .def_readwrite("tile_mask", &RenderSettings::tile_mask,
+                       "[] = every tile; else one flag per TILE_SIZE^2 tile, row-major: only flagged tiles render")
         .def("__repr__", &RenderSettings::to_string);
 
     py::class_<RasterizeSettings>(m, "RasterizeSettings", "Image size, sampling, depth convention and culling of rasterize().")
@@ -207,6 +218,14 @@ void bind_render(py::module_& m) {
         },
         py::arg("kind"), py::arg("samples"), py::arg("seed") = 0,
         "Sample offsets from a pixel's top-left corner in pixels, (S, 2) float64 (multiples of 1/256).");
+    m.def(
+        "interleaved_halves",
+        [](PatternKind kind, int samples, std::uint64_t seed) {
+            return interleaved_halves(make_sample_pattern(kind, samples, seed));
+        },
+        py::arg("kind"), py::arg("samples"), py::arg("seed") = 0,
+        "The half (0 or 1) of each sample that the error estimate compares: a checkerboard over the\n"
+        "pattern's strata. ValueError for fewer than 2 samples.");
     m.def("validate_framebuffer_size", &validate_framebuffer_size, py::arg("width"), py::arg("height"),
           py::arg("samples"), py::arg("with_depth"),
           "Raises ValueError naming the size or sample count that is out of range (or too much memory).");

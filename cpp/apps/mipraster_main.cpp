@@ -68,6 +68,11 @@ constexpr const char* kUsage =
     "             what was tried, the figure measured, its bound, PASS/FAIL\n"
   "  resize     resize an image with a reconstruction filter (in linear colour, widened when shrinking)\n"
   "  synthesize grow a texture like a sample image (Efros & Leung non-parametric sampling)\n"
+    "  study      error against run time of the quality knobs (samples, pattern, SSAA/MSAA,\n"
+    "             texture filter, anisotropy, LOD bias): CSV, Markdown table and plot. It runs in\n"
+    "             Python: the binary hands its arguments to `python3 -m mipraster.study` (the\n"
+    "             python3 beside this binary, else $MIPRASTER_PYTHON, else the one on PATH);\n"
+    "             mipraster study --help lists its options\n"
     "\n"
     "render options:\n"
     "  -o, --output PATH     output image: .png (sRGB 8-bit) or .exr (linear float)  [required]\n"
@@ -93,8 +98,11 @@ constexpr const char* kUsage =
     "  --derivatives D       analytic (exact per sample) or quad (2x2 finite differences) [analytic]\n"
   "  --resolve F           resolve filter: box (mean of the pixel's samples), tent, mitchell,\n"
   "                        catmull-rom, lanczos3 (also weigh the samples of nearby pixels) [box]\n"
-    "  --stats               print triangle, sample and per-stage time counts\n"
+    "  --stats               print triangle, sample and per-stage time counts, and (spp >= 2)\n"
+    "                        the estimated RMSE from two interleaved halves of the samples\n"
     "  --stats-json PATH     write the counts and times as JSON (- = stdout)\n"
+    "  --error-map PATH      write the per-pixel error estimate (RMS over linear R, G, B from two\n"
+    "                        interleaved halves of the samples; .exr linear, .png sRGB grey); spp >= 2\n"
     "  --quiet               print nothing but errors (no summary, no progress bar)\n"
     "\n"
     "compare A B [options]: values are compared as read (linear float; 8-bit files are decoded\n"
@@ -195,6 +203,7 @@ struct RenderOptions {
     RenderSettings settings;
     bool print_stats = false;
     std::string stats_json;  ///< path, "-" for stdout, empty for none
+    std::string error_map;   ///< --error-map PATH: the per-pixel error estimate; empty for none
     bool quiet = false;
     std::vector<double> look_at;  ///< empty: the demo's camera
     double fov_degrees = 0.0;     ///< 0: the demo's
@@ -302,6 +311,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
             o.print_stats = true;
         } else if (a == "--stats-json") {
             o.stats_json = value();
+        } else if (a == "--error-map") {
+            o.error_map = value();
         } else if (a == "--quiet") {
             o.quiet = true;
         } else if (!a.empty() && a[0] != '-' && o.scene.empty()) {
@@ -315,6 +326,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     if (o.camera >= 0 && o.scene.empty())
         throw UsageError("--camera: needs a scene file (the built-in demo has one camera)");
     if (o.output.empty()) throw UsageError("render: missing -o PATH (where to write the image)");
+    if (!o.error_map.empty() && o.settings.samples < 2)
+        throw UsageError("--error-map: the estimate compares two halves of each pixel's samples; give --spp 2 or more");
     return o;
 }
 
@@ -370,13 +383,23 @@ int run_render(const std::vector<std::string>& args) {
     if (sampler_flags && !o.quiet && std::none_of(draws.begin(), draws.end(), [](const Draw& d) { return bool(d.texture); }))
         std::fprintf(stderr, "mipraster: warning: the scene has no textured draw; the texture options change nothing\n");
     if (!o.quiet && isatty(STDOUT_FILENO)) settings.progress = draw_progress;
+    settings.estimate_error = (o.print_stats && settings.samples >= 2) || !o.error_map.empty();
     const RenderResult result = render(draws, camera, settings);
     write_image(o.output, result.color);
     if (!o.quiet)
         std::printf("wrote %s (%dx%d, %d spp %s, %.1f ms on %d threads)\n", o.output.c_str(), settings.width,
                     settings.height, settings.samples, to_string(settings.anti_aliasing).c_str(), result.stats.total_ms,
                     result.stats.threads);
-    if (o.print_stats) std::printf("%s\n%s\n", result.pattern.to_string().c_str(), result.stats.to_string().c_str());
+    if (!o.error_map.empty()) write_image(o.error_map, result.error_map);
+    if (o.print_stats) {
+        std::printf("%s\n%s\n", result.pattern.to_string().c_str(), result.stats.to_string().c_str());
+        if (settings.estimate_error)
+            std::printf("error estimate (linear RGB, from two interleaved halves of the samples; sampling error "
+                        "only, not filter blur): rmse=%.6g, worst pixel=%.6g\n",
+                        result.error_estimate.rmse, result.error_estimate.max_pixel);
+        else
+            std::printf("error estimate: needs --spp 2 or more\n");
+    }
     if (o.stats_json == "-") {
         std::printf("%s\n", result.stats.to_json().c_str());
     } else if (!o.stats_json.empty()) {
@@ -519,19 +542,32 @@ int run_compare(const std::vector<std::string>& args) {
     return report.passed ? 0 : 1;
 }
 
-// Commands written in Python (they drive numpy scenes and other renderers): replace this
-// process with `PYTHON -m MODULE ARGS...`, the interpreter from $MIPRASTER_PYTHON or python3.
-int run_python_module(const char* module, const std::vector<std::string>& args) {
-    const char* env = std::getenv("MIPRASTER_PYTHON");
-    const std::string python = env && *env ? env : "python3";
+// Where `mipraster study` finds Python: the python3 beside this binary (a virtual environment's
+// bin/), else $MIPRASTER_PYTHON, else python3 on PATH.
+std::string python_executable() {
+    char self[4096];
+    const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n > 0) {
+        std::string dir(self, static_cast<std::size_t>(n));
+        dir = dir.substr(0, dir.find_last_of('/'));
+        const std::string beside = dir + "/python3";
+        if (access(beside.c_str(), X_OK) == 0) return beside;
+    }
+    if (const char* env = std::getenv("MIPRASTER_PYTHON"); env && *env) return env;
+    return "python3";
+}
+
+// Hands a subcommand whose home is the Python package to `python3 -m MODULE ARGS...`.
+int run_python_module(const std::string& module, const std::vector<std::string>& args) {
+    const std::string python = python_executable();
     std::vector<std::string> words = {python, "-m", module};
     words.insert(words.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (std::string& w : words) argv.push_back(w.data());
     argv.push_back(nullptr);
-    execvp(argv[0], argv.data());
-    std::fprintf(stderr, "mipraster: cannot run '%s -m %s': %s (set MIPRASTER_PYTHON to the interpreter that has "
-                 "the mipraster package)\n", python.c_str(), module, std::strerror(errno));
+    execvp(python.c_str(), argv.data());
+    std::fprintf(stderr, "mipraster: error: this command runs in Python (%s -m %s) and %s could not be started: %s\n",
+                 python.c_str(), module.c_str(), python.c_str(), std::strerror(errno));
     return 1;
 }
 
@@ -591,6 +627,7 @@ int main(int argc, char** argv) {
         if (args[0] == "stress") return run_stress({args.begin() + 1, args.end()});
         if (args[0] == "resize") return run_resize({args.begin() + 1, args.end()});
         if (args[0] == "synthesize") return run_synthesize({args.begin() + 1, args.end()});
+        if (args[0] == "study") return run_python_module("mipraster.study", {args.begin() + 1, args.end()});
         throw UsageError("unknown command '" + args[0] + "'");
     } catch (const UsageError& e) {
         std::fprintf(stderr, "mipraster: %s\n\n%s", e.what(), kUsage);

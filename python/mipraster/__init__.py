@@ -39,6 +39,10 @@ case (also ``mipraster stress`` on the command line).
 :func:`resample` resizes an image with a reconstruction filter (box, tent, Mitchell–Netravali,
 Catmull–Rom, Lanczos-3; widened when shrinking, in linear colour) and :func:`synthesize` grows a new
 texture from a sample (Efros & Leung), ready to use as a :class:`Texture`.
+:func:`render` can estimate its own error (``estimate_error=True``: ``result.error_map``,
+``result.error_estimate``) and spend samples adaptively (``target_error=e``). The error-against-time
+study is :func:`mipraster.study.study` (``python -m mipraster.study``, ``mipraster study``); its
+ground truths are in :mod:`mipraster.reference` and its scenes in :mod:`mipraster.study_scenes`.
 
 :func:`compare` compares two images value by value with thresholds (OpenImageIO ``idiff`` style) and
 returns a :class:`CompareReport`; :mod:`mipraster.testing` (imported explicitly) builds golden-image

@@ -14,6 +14,7 @@ MAX_DIMENSION: int
 MAX_SAMPLES: int
 MAX_THREADS: int
 SUBPIXEL_ONE: int
+TILE_SIZE: int
 
 class _Enum:
     name: str
@@ -181,6 +182,8 @@ class RenderSettings:
     derivatives: str
     debug_view: str
     resolve_filter: str
+    estimate_error: bool
+    tile_mask: List[int]
     def __init__(self) -> None: ...
     @property
     def clear_color(self) -> _RGBA: ...
@@ -199,10 +202,12 @@ class RasterizeSettings:
     def __init__(self) -> None: ...
 
 def sample_pattern(kind: PatternKind, samples: int, seed: int = 0) -> _Float64Array: ...
+def interleaved_halves(kind: PatternKind, samples: int, seed: int = 0) -> List[int]: ...
 def validate_framebuffer_size(width: int, height: int, samples: int, with_depth: bool) -> None: ...
 def render(draws: List[Draw], camera: Camera, settings: RenderSettings) -> Dict[str, Any]:
     """Keys: color (H, W, 4) float32; depth (H, W) float32 or None; samples (H, W, S, 4) float32 or
-    None; sample_depth (H, W, S) float32 or None; pattern (S, 2) float64; pattern_kind str; stats dict."""
+    None; sample_depth (H, W, S) float32 or None; error_map (H, W) float32 or None; error_estimate
+    float or None; pattern (S, 2) float64; pattern_kind str; stats dict."""
 def rasterize(pos_clip: _ArrayLike, triangles: _ArrayLike, settings: RasterizeSettings) -> Dict[str, Any]:
     """Keys: triangle_id (H, W, S) int32; barycentrics (H, W, S, 2) float32; depth (H, W, S) float32;
     pattern (S, 2) float64; pattern_kind str; stats dict."""

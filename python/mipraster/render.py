@@ -43,6 +43,13 @@ class RenderResult:
         pattern: ``(S, 2)`` float64 sample offsets from the pixel's top-left corner, in pixels
             (multiples of 1/256).
         pattern_kind: the pattern used (``"center"``, ``"grid"``, ``"rotated"`` or ``"stratified"``).
+        error_map: ``(H, W)`` float32 per-pixel error estimate (root mean square over R, G, B of the
+            linear colour) when the render was asked for one (``estimate_error=True`` or
+            ``target_error``), else None. It comes from the disagreement of two interleaved halves
+            of each pixel's samples (see :func:`render`).
+        error_estimate: the estimated RMSE of the whole image (linear R, G, B), or None.
+        tile_spp: ``(tiles_y, tiles_x)`` int array of the samples per pixel each 32×32 tile got, for
+            an adaptive render (``target_error``), else None.
         stats: dict of the renderer's counters (``triangles_in``, ``triangles_clipped``,
             ``triangles_outside``, ``triangles_backface``, ``triangles_degenerate``,
             ``triangles_nonfinite``, ``triangles_rasterized``, ``samples_covered``,
@@ -50,7 +57,8 @@ class RenderResult:
             (``transform_ms``, ``setup_ms``, ``raster_ms``, ``total_ms``).
     """
 
-    __slots__ = ("color", "depth", "samples", "sample_depth", "pattern", "pattern_kind", "stats")
+    __slots__ = ("color", "depth", "samples", "sample_depth", "pattern", "pattern_kind", "stats", "error_map",
+                 "error_estimate", "tile_spp")
 
     def __init__(self, raw: Dict[str, Any]) -> None:
         self.color: np.ndarray = raw["color"]
@@ -60,6 +68,10 @@ class RenderResult:
         self.pattern: np.ndarray = raw["pattern"]
         self.pattern_kind: str = raw["pattern_kind"]
         self.stats: Dict[str, Union[int, float]] = raw["stats"]
+        self.error_map: Optional[np.ndarray] = raw.get("error_map")
+        estimate = raw.get("error_estimate")
+        self.error_estimate: Optional[float] = None if estimate is None else float(estimate)
+        self.tile_spp: Optional[np.ndarray] = raw.get("tile_spp")
 
     @property
     def width(self) -> int:
@@ -93,7 +105,8 @@ class RenderResult:
     def __repr__(self) -> str:
         return (f"RenderResult({self.width}x{self.height}, spp={self.spp} {self.pattern_kind}, "
                 f"samples={'kept' if self.samples is not None else 'None'}, "
-                f"total_ms={self.stats['total_ms']:.3f})")
+                + (f"error_estimate={self.error_estimate:.4g}, " if self.error_estimate is not None else "")
+                + f"total_ms={self.stats['total_ms']:.3f})")
 
 
 def _int_in(value: Any, name: str, lo: int, hi: int, expected: str) -> int:
@@ -106,7 +119,8 @@ def _int_in(value: Any, name: str, lo: int, hi: int, expected: str) -> int:
 def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, aa: str = "ssaa",
            pattern: str = "auto", seed: int = 0, threads: int = 0, clear_color: Any = None,
            keep_samples: bool = False, depth: bool = True, derivatives: str = "analytic",
-           debug_view: str = "none", resolve_filter: str = "box") -> RenderResult:
+           debug_view: str = "none", resolve_filter: str = "box", estimate_error: bool = False,
+           target_error: Optional[float] = None) -> RenderResult:
     """Renders ``scene`` through ``camera`` into a ``width`` × ``height`` image.
 
     Args:
@@ -134,6 +148,19 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             ``"catmull-rom"``, ``"lanczos3"``; radius in pixels) that weighs the samples of the
             pixels around it too: for a grid pattern, the same as resampling the image of the
             samples to the output size with that filter. One sample per pixel runs no resolve.
+        estimate_error: also estimate the render's error without a reference: each pixel's samples
+            are split into two interleaved halves A and B (a checkerboard over the pattern's
+            strata) and the full resolve's error is estimated as |A − B|·√(nA·nB)/n, exact in
+            expectation when the samples' errors are independent. It sees sampling error (edges,
+            texture detail between samples), not error that every sample shares (a blurring
+            texture filter; MSAA's one shade per pixel). Needs ``spp >= 2``. Fills
+            ``error_map`` and ``error_estimate``.
+        target_error: adaptive quality: render at ``spp`` (at least 2), then re-render the 32×32
+            tiles whose estimated error needs it with the samples the estimate says they need
+            (error ∝ 1/√spp; the fewest samples for the image's estimated RMSE), up to 64, until
+            the image's estimate meets ``target_error`` (an RMSE in linear colour) or every tile
+            with any error has 64 (see :mod:`mipraster.adaptive`).
+            ``stats['total_ms']`` is the time of all passes; ``tile_spp`` shows where samples went.
 
     Returns:
         A :class:`RenderResult`.
@@ -161,6 +188,10 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     derivative_mode = _checks.choice(derivatives, "derivatives", DERIVATIVES)
     debug = _checks.choice(debug_view, "debug_view", DEBUG_VIEWS)
     resolve = _checks.choice(resolve_filter, "resolve_filter", {f: f for f in RESAMPLE_FILTERS})
+    estimate = _checks.flag(estimate_error, "estimate_error")
+    if (estimate or target_error is not None) and samples == 1:
+        raise ValueError("estimate_error / target_error: the error estimate compares two halves of each "
+                         "pixel's samples; give spp >= 2")
     if clear_color is None:
         clear_color = scene.clear_color if scene.clear_color is not None else (0.0, 0.0, 0.0, 0.0)
     clear = _checks.rgba(clear_color, "clear_color")
@@ -177,4 +208,9 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     settings.depth_output = depth_output
     settings.derivatives, settings.debug_view = derivative_mode, debug
     settings.resolve_filter = resolve
+    settings.estimate_error = estimate or target_error is not None
+    if target_error is not None:
+        from .adaptive import render_adaptive_settings
+
+        return render_adaptive_settings(draws, core_camera, settings, target_error)
     return RenderResult(_core.render(draws, core_camera, settings))

@@ -285,6 +285,16 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     RenderResult result;
     result.pattern = make_sample_pattern(settings.pattern, settings.samples, settings.pattern_seed);
     validate_draws(draws);
+    const std::vector<std::uint8_t> halves =
+        settings.estimate_error ? interleaved_halves(result.pattern) : std::vector<std::uint8_t>{};
+    {
+        const TileGrid g = TileGrid::for_viewport(settings.width, settings.height);
+        if (!settings.tile_mask.empty() && settings.tile_mask.size() != static_cast<std::size_t>(g.count()))
+            throw std::invalid_argument("tile_mask: expected " + std::to_string(g.count()) + " flags (" +
+                                        std::to_string(g.tiles_x) + " x " + std::to_string(g.tiles_y) +
+                                        " tiles of " + std::to_string(kTileSize) + " px), got " +
+                                        std::to_string(settings.tile_mask.size()));
+    }
     const bool depth_output = settings.depth_output && needs_depth;
     const DepthDecoder decoder = depth_output ? camera.depth_decoder() : DepthDecoder{};
     const int threads = resolve_thread_count(settings.threads);
@@ -337,6 +347,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         kept = make_framebuffer(settings.width, settings.height, S, settings.clear_color, needs_depth, clear_depth);
     result.color = Image(settings.width, settings.height, 4);
     if (depth_output) result.depth = Image(settings.width, settings.height, 1);
+    if (settings.estimate_error) result.error_map = Image(settings.width, settings.height, 1);
     std::vector<TileKernel> kernels(draws.size());
     std::vector<DrawInputs> inputs(draws.size());
     std::vector<std::unique_ptr<TextureView>> textures(draws.size());  // pinned for the render
@@ -360,6 +371,15 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     std::size_t tiles_done = 0;
     pool.parallel_for(static_cast<std::size_t>(grid.count()), [&](std::size_t tile) {
         TileTarget target = tile_target(grid, tile, result.pattern);
+        if (!settings.tile_mask.empty() && !settings.tile_mask[tile]) {
+            // Not asked for: the clear colour, no samples drawn, no error.
+            SampleWindow image{result.color.pixels.data(), 4, 0, 0, settings.width, 1};
+            image.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
+            if (depth_output)
+                SampleWindow{result.depth.pixels.data(), 1, 0, 0, settings.width, 1}.fill(
+                    target.x0, target.y0, target.x1, target.y1, glm::vec4(std::numeric_limits<float>::infinity()));
+            return;
+        }
         // Tile-local storage, reused by each worker thread from tile to tile.
         thread_local std::vector<float> tile_color, tile_depth;
         if (whole_frame) {
@@ -382,6 +402,8 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
         if ((settings.keep_samples || S > 1) && !wide_resolve)
             resolve_tile(target.color, target.x0, target.y0, target.x1, target.y1, settings.resolve_filter, result.color);
+        if (settings.estimate_error)
+            estimate_tile_error(target.color, halves, target.x0, target.y0, target.x1, target.y1, result.error_map);
         if (depth_output)
             resolve_view_depth(target.depth, target.x0, target.y0, target.x1, target.y1, clear_depth, decoder,
                                result.depth);
@@ -393,6 +415,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     if (wide_resolve) resolve_framebuffer(kept, result.pattern, settings.resolve_filter, pool, result.color);
     add_counters(tile_counters, stats);
     if (settings.keep_samples) result.framebuffer = std::move(kept);
+    if (settings.estimate_error) result.error_estimate = summarize_error_map(result.error_map);
     stats.raster_ms = ms_since(t0);
     stats.total_ms = ms_since(start);
     return result;
@@ -486,7 +509,9 @@ std::string RenderSettings::to_string() const {
            std::to_string(samples) + ", pattern=" + mipraster::to_string(pattern) + ", aa=" +
            mipraster::to_string(anti_aliasing) + ", threads=" + std::to_string(threads) + ", resolve=" +
            mipraster::to_string(resolve_filter) + ", derivatives=" + mipraster::to_string(derivatives) +
-           ", debug_view=" + mipraster::to_string(debug_view) + ")";
+           ", debug_view=" + mipraster::to_string(debug_view) +
+           (estimate_error ? ", estimate_error" : "") +
+           (tile_mask.empty() ? "" : ", tile_mask=" + std::to_string(tile_mask.size()) + " tiles") + ")";
 }
 
 std::string RenderStats::to_json() const {

@@ -10,6 +10,7 @@
 
 #include "mipraster/core/image.hpp"
 #include "mipraster/pipeline/draw.hpp"
+#include "mipraster/pipeline/error_estimate.hpp"
 #include "mipraster/pipeline/framebuffer.hpp"
 #include "mipraster/pipeline/resolve.hpp"
 #include "mipraster/pipeline/sample_pattern.hpp"
@@ -41,6 +42,13 @@ struct RenderSettings {
     bool depth_output = false;                      ///< return RenderResult::depth (when some draw tests depth)
     DerivativeMode derivatives = DerivativeMode::analytic;  ///< uv derivatives of textured draws
     DebugView debug_view = DebugView::none;         ///< replaces the texture lookup of textured draws
+    /// Estimate the error from two interleaved halves of the samples (error_estimate.hpp) into
+    /// RenderResult::error_map; needs samples ≥ 2.
+    bool estimate_error = false;
+    /// Empty: render every tile. Otherwise one flag per kTileSize² tile, row-major over
+    /// ⌈W/kTileSize⌉ × ⌈H/kTileSize⌉: only flagged tiles are rendered, the others keep the clear
+    /// colour (adaptive sampling re-renders the tiles that need more samples).
+    std::vector<std::uint8_t> tile_mask;
     /// Called as tiles finish with (tiles done, tiles in all); calls are serialized (never
     /// concurrent) but may come from any worker thread. Empty: no progress reports.
     std::function<void(std::size_t, std::size_t)> progress;
@@ -76,6 +84,9 @@ struct RenderResult {
     /// drawn; only with RenderSettings::depth_output and when some draw tests depth, else empty.
     Image depth;
     Framebuffer framebuffer;  ///< all samples, when RenderSettings::keep_samples
+    /// (H, W, 1) per-pixel error estimate (RMS over R, G, B), with RenderSettings::estimate_error.
+    Image error_map;
+    ErrorEstimate error_estimate;  ///< its summary (zero without estimate_error)
     SamplePattern pattern;
     RenderStats stats;
 };
