@@ -97,11 +97,18 @@ TEST(MemoryLimit, EstimateGrowsWithWhatTheRenderKeeps) {
     const mr::RenderSettings plain = sized(200, 100, 16);
     mr::RenderSettings kept = plain;
     kept.keep_samples = true;
+    mr::RenderSettings wide = plain;
+    wide.resolve_filter = mr::ResolveFilter::mitchell;
+    mr::RenderSettings estimated = plain;
+    estimated.estimate_error = true;
     mr::RenderSettings more_threads = plain;
     more_threads.threads = 4;
     const std::uint64_t base = reported_bytes(refusal(draws, plain));
     // Keeping the samples adds the whole sample framebuffer: 200·100·16 samples × 20 bytes.
     EXPECT_EQ(reported_bytes(refusal(draws, kept)) - base, 200u * 100u * 16u * 20u);
+    // So does a resolve filter wider than a pixel; the error estimate adds its map (4 bytes a pixel).
+    EXPECT_EQ(reported_bytes(refusal(draws, wide)) - base, 200u * 100u * 16u * 20u);
+    EXPECT_EQ(reported_bytes(refusal(draws, estimated)) - base, 200u * 100u * 4u);
     // Each further worker adds its tile buffers: 32² pixels × 16 samples × 20 bytes.
     EXPECT_EQ(reported_bytes(refusal(draws, more_threads)) - base, 3u * 32u * 32u * 16u * 20u);
 }

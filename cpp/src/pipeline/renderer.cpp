@@ -255,7 +255,11 @@ std::uint64_t render_bytes(const std::vector<Draw>& draws, const RenderSettings&
     const std::uint64_t sample_bytes = (4 + (needs_depth ? 1 : 0)) * sizeof(float);
     std::uint64_t bytes = pixels * 4 * sizeof(float);  // the resolved colour
     if (depth_output) bytes += pixels * sizeof(float);
-    if (settings.keep_samples) bytes += framebuffer_bytes(settings.width, settings.height, settings.samples, needs_depth);
+    if (settings.estimate_error) bytes += pixels * sizeof(float);  // the error map
+    // Kept samples, or a resolve filter wider than a pixel: a whole-frame sample buffer.
+    const bool wide_resolve = settings.resolve_filter != ResolveFilter::box && settings.samples > 1;
+    if (settings.keep_samples || wide_resolve)
+        bytes += framebuffer_bytes(settings.width, settings.height, settings.samples, needs_depth);
     bytes += std::uint64_t(threads) * kTileSize * kTileSize * std::uint64_t(settings.samples) * sample_bytes;
     for (const Draw& d : draws) bytes += geometry_bytes(d.mesh->positions.size(), d.mesh->triangles.size());
     return bytes;
