@@ -85,8 +85,7 @@ void check_size(int width, int height, int channels, const std::string& name) {
 
 // Expands 1–4 channels to premultiplied RGBA. `colour(i)` and `alpha(i)` decode raw value i.
 template <typename Decode, typename Alpha>
-TextureLevel expand(int width, int height, int channels, bool premultiply, Decode colour, Alpha alpha,
-                    const std::string& name) {
+TextureLevel expand(int width, int height, int channels, bool premultiply, Decode colour, Alpha alpha) {
     TextureLevel level(width, height);
     const std::size_t n = level.texels.size();
     for (std::size_t p = 0; p < n; ++p) {
@@ -97,13 +96,7 @@ TextureLevel expand(int width, int height, int channels, bool premultiply, Decod
         } else {
             t = glm::vec4(colour(i), colour(i + 1), colour(i + 2), channels == 4 ? alpha(i + 3) : 1.0f);
         }
-        if (premultiply) {
-            t = glm::vec4(glm::vec3(t) * t.a, t.a);
-            // Finite float texels whose product is not (e.g. colour and alpha of 1e30).
-            if (!std::isfinite(t.r) || !std::isfinite(t.g) || !std::isfinite(t.b))
-                throw std::invalid_argument("texture '" + name + "': texel (" + std::to_string(p % width) + ", " + std::to_string(p / width) +
-                                            "): colour × alpha overflows the float range");
-        }
+        if (premultiply) t = glm::vec4(glm::vec3(t) * t.a, t.a);
         level.texels[p] = t;
     }
     return level;
@@ -142,9 +135,9 @@ Texture Texture::from_8bit(const std::uint8_t* texels, int width, int height, in
     check_size(width, height, channels, name);
     std::array<float, 256> decode;
     for (int c = 0; c < 256; ++c) decode[c] = srgb ? srgb_to_linear(c / 255.0f) : c / 255.0f;
-    TextureLevel level = expand(width, height, channels, true, [&](std::size_t i) { return decode[texels[i]]; },
-                                [&](std::size_t i) { return texels[i] / 255.0f; }, name);
-    return Texture(std::move(level), std::move(name));
+    return Texture(expand(width, height, channels, true, [&](std::size_t i) { return decode[texels[i]]; },
+                          [&](std::size_t i) { return texels[i] / 255.0f; }),
+                   std::move(name));
 }
 
 Texture Texture::from_16bit(const std::uint16_t* texels, int width, int height, int channels, bool srgb,
@@ -152,17 +145,16 @@ Texture Texture::from_16bit(const std::uint16_t* texels, int width, int height, 
     check_size(width, height, channels, name);
     std::vector<float> decode(65536);
     for (int c = 0; c < 65536; ++c) decode[c] = srgb ? srgb_to_linear(c / 65535.0f) : c / 65535.0f;
-    TextureLevel level = expand(width, height, channels, true, [&](std::size_t i) { return decode[texels[i]]; },
-                                [&](std::size_t i) { return texels[i] / 65535.0f; }, name);
-    return Texture(std::move(level), std::move(name));
+    return Texture(expand(width, height, channels, true, [&](std::size_t i) { return decode[texels[i]]; },
+                          [&](std::size_t i) { return texels[i] / 65535.0f; }),
+                   std::move(name));
 }
 
 Texture Texture::from_float(const float* texels, int width, int height, int channels, bool premultiplied,
                             std::string name) {
     check_size(width, height, channels, name);
     auto value = [&](std::size_t i) { return texels[i]; };
-    TextureLevel level = expand(width, height, channels, !premultiplied, value, value, name);
-    return Texture(std::move(level), std::move(name));
+    return Texture(expand(width, height, channels, !premultiplied, value, value), std::move(name));
 }
 
 Texture Texture::from_image(const Image& image, std::string name) {
