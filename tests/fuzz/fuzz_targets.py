@@ -25,7 +25,8 @@ import mipraster as mr
 EXPECTED = (ValueError, TypeError, OSError)
 SCENE_EXTENSIONS = (".obj", ".gltf", ".glb")
 IMAGE_EXTENSIONS = (".png", ".exr", ".jpg", ".tga", ".hdr", ".ppm")
-_TMP = tempfile.mkdtemp(prefix="mipraster_fuzz_")
+# Inputs go through a file (the loaders take paths): in memory where the system has a tmpfs.
+_TMP = tempfile.mkdtemp(prefix="mipraster_fuzz_", dir="/dev/shm" if os.path.isdir("/dev/shm") else None)
 # Every target renders and loads within this, so an absurd header or size is refused quickly.
 FUZZ_MEMORY_LIMIT = 256 << 20
 

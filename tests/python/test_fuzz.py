@@ -20,6 +20,15 @@ CORPUS = FUZZ_DIR / "corpus"
 SHORT_RUN_SECONDS = int(os.environ.get("MIPRASTER_FUZZ_SECONDS", "20"))
 
 
+@pytest.fixture(autouse=True)
+def default_memory_limit():
+    """The targets lower the process-wide memory limit; the other tests expect the default."""
+    yield
+    import mipraster
+
+    mipraster.set_memory_limit(0)
+
+
 @pytest.mark.parametrize("target", sorted(fuzz_targets.TARGETS))
 def test_every_seed_is_accepted(target):
     seeds = sorted((CORPUS / target).iterdir())
