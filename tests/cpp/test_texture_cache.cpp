@@ -330,4 +330,54 @@ TEST(TextureCache, ConcurrentLookupsMatchSequential) {
     EXPECT_EQ(after.tables_built - before.tables_built, 1u);
 }
 
+// Lookups racing with eviction: under a zero budget every released pin evicts the texture's
+// derived data, while other threads pin the same textures, build their levels again and sample
+// them. Every lookup gives the bits of the sequential reference, and nothing is left built.
+TEST(TextureCache, ConcurrentLookupsAndEvictionMatchSequential) {
+    BudgetGuard guard;
+    constexpr int kTextures = 3, kThreads = 4, kRounds = 60;
+    std::vector<mr::TextureLevel> levels;
+    for (int i = 0; i < kTextures; ++i) levels.push_back(to::random_level(64 + 16 * i, 48, 40 + i));
+    const mr::Sampler trilinear = mr::Sampler::from_filter_name("trilinear");
+    const mr::Sampler sat = mr::Sampler::from_filter_name("sat");
+    std::mt19937_64 rng(41);
+    std::uniform_real_distribution<float> d(-0.5f, 1.5f), lg(0.0f, 6.0f);
+    std::vector<Query> queries;
+    for (int i = 0; i < 64; ++i) {
+        const float r = std::exp2(lg(rng)) / 64;
+        queries.push_back({i % 2, {d(rng), d(rng)}, {r, 0.3f * r}, {-0.2f * r, r}});
+    }
+    auto lookup = [&](const mr::TextureView& view, const Query& q) {
+        return mr::sample_texture(view, q.filter ? sat : trilinear, q.uv, q.dx, q.dy);
+    };
+    std::vector<std::vector<glm::vec4>> expected(kTextures);
+    for (int i = 0; i < kTextures; ++i) {
+        mr::Texture reference(levels[i], "reference");
+        mr::TextureView view(reference);
+        for (const Query& q : queries) expected[i].push_back(lookup(view, q));
+    }
+
+    std::vector<mr::Texture> shared;
+    for (int i = 0; i < kTextures; ++i) shared.emplace_back(levels[i], "shared");
+    mr::TextureCache::global().set_budget(0);
+    const std::uint64_t evictions0 = mr::TextureCache::global().stats().evictions;
+    std::atomic<int> mismatches{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t)
+        threads.emplace_back([&, t] {
+            for (int round = 0; round < kRounds; ++round) {
+                const int i = (t + round) % kTextures;
+                mr::TextureView view(shared[i]);  // pins; its release evicts under the zero budget
+                for (std::size_t k = 0; k < queries.size(); ++k) {
+                    const glm::vec4 got = lookup(view, queries[k]);
+                    if (std::memcmp(&expected[i][k], &got, sizeof got) != 0) ++mismatches;
+                }
+            }
+        });
+    for (std::thread& th : threads) th.join();
+    EXPECT_EQ(mismatches.load(), 0);
+    EXPECT_GT(mr::TextureCache::global().stats().evictions, evictions0);  // eviction did race the lookups
+    for (const mr::Texture& tex : shared) EXPECT_EQ(tex.built_levels(), 0) << "unpinned under a zero budget";
+}
+
 }  // namespace

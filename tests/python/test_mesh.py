@@ -32,6 +32,16 @@ def test_lists_and_tuples_are_accepted():
     assert (mesh.vertex_count, mesh.triangle_count) == (4, 2)
 
 
+def test_read_only_arrays_are_accepted_and_left_alone():
+    positions = np.array(POSITIONS, dtype=np.float32)
+    triangles = np.array(TRIANGLES, dtype=np.int64)
+    for a in (positions, triangles):
+        a.flags.writeable = False
+    mesh = mr.Mesh(positions, triangles)
+    np.testing.assert_array_equal(mesh.positions, positions)
+    assert not positions.flags.writeable and not triangles.flags.writeable
+
+
 def test_non_contiguous_and_fortran_order_arrays_keep_their_values():
     wide = np.zeros((4, 6))
     wide[:, ::2] = POSITIONS
