@@ -64,6 +64,18 @@ def test_a_quad_at_2_to_the_k_texels_per_pixel_shows_level_k(k):
     np.testing.assert_allclose(color, box_level(texels, k), rtol=0, atol=2e-6)
 
 
+@pytest.mark.parametrize("k, spp", [(2, 16), (3, 4), (3, 16), (4, 64)])
+def test_ssaa_samples_read_the_level_of_their_own_spacing(k, spp):
+    # 2^k texels per pixel, an N×N grid of samples (N = √spp): each sample stands for a cell of
+    # 2^k / N texels, so it reads level k − log2 N, at that level's texel centres, and the pixel is
+    # the mean of N×N of them: level k again, exactly. (Filtering each sample at the pixel's
+    # footprint would read level k between its texels: a blur.)
+    texels = random_texture(k + spp)
+    size = TEX >> k
+    color, _ = render_quad(texels, size, "trilinear", spp=spp, aa="ssaa", pattern="grid")
+    np.testing.assert_allclose(color, box_level(texels, k), rtol=0, atol=2e-6)
+
+
 @pytest.mark.parametrize("k", [0, 1, 2, 3])
 def test_half_a_level_further_trilinear_blends_levels_k_and_k_plus_1_equally(k):
     texels = random_texture(10 + k)

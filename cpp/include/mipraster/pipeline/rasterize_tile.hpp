@@ -60,6 +60,9 @@ struct DrawInputs {
     Interpolation uv_interpolation = Interpolation::perspective;
     DerivativeMode derivatives = DerivativeMode::analytic;
     DebugView debug_view = DebugView::none;
+    /// Multiplies the uv derivatives: 1/√S under SSAA, where each of the S samples stands for a
+    /// 1/√S-pixel cell (as if rendered at √S× the resolution), else 1.
+    double footprint_scale = 1.0;
 };
 
 /// Triangles of one draw, in submission order: tris[indices[k]] for k < count.
