@@ -288,6 +288,11 @@ TEST(Resolve, NonSquareCountsUseTheMostSquareGridAndStrata) {
         EXPECT_TRUE(same_offsets(to_oracle(mr::make_sample_pattern(mr::PatternKind::grid, S)), want)) << "S = " << S;
         EXPECT_TRUE(same_offsets(to_oracle(mr::make_sample_pattern(mr::PatternKind::automatic, S)), want)) << "S = " << S;
         const mr::SamplePattern j = mr::make_sample_pattern(mr::PatternKind::stratified, S, 7);
+        // The cells the samples stand for (SSAA filters each sample's texture footprint over one).
+        for (const mr::SamplePattern& p : {mr::make_sample_pattern(mr::PatternKind::grid, S), j}) {
+            EXPECT_EQ(p.columns, cols) << "S = " << S;
+            EXPECT_EQ(p.rows, rows) << "S = " << S;
+        }
         std::vector<int> per(static_cast<std::size_t>(S), 0);
         for (int k = 0; k < j.count(); ++k) {
             // Stratum a covers [⌊256·a/cols⌋, ⌊256·(a+1)/cols⌋) on the 1/256 grid.
@@ -300,6 +305,10 @@ TEST(Resolve, NonSquareCountsUseTheMostSquareGridAndStrata) {
         }
         for (int c : per) EXPECT_EQ(c, 1) << "S = " << S;
     }
+    const mr::SamplePattern rotated = mr::make_sample_pattern(mr::PatternKind::rotated, 4);
+    EXPECT_EQ(rotated.columns * 10 + rotated.rows, 22);
+    const mr::SamplePattern centre = mr::make_sample_pattern(mr::PatternKind::center, 1);
+    EXPECT_EQ(centre.columns * 10 + centre.rows, 11);
     // Every count renders, watertight: a covering triangle pair gives each sample exactly 1.
     for (int S = 1; S <= 64; ++S) {
         mr::Mesh quad = fixed_triangle({-4096, -4096}, {8192, -4096}, {-4096, 8192});

@@ -30,9 +30,9 @@ inline glm::vec4 texture_colour(const DrawInputs& draw, const SetupTriangle& t, 
     UvSample s = interpolate_uv<kLod>(t, uvs, l, draw.uv_interpolation);
     if constexpr (kLod) {
         if (draw.derivatives == DerivativeMode::quad) quad_derivatives(t, uvs, draw.uv_interpolation, px, py, s);
-        if (draw.footprint_scale != 1.0) {  // SSAA: the sample's own footprint, not the pixel's
-            s.dx *= draw.footprint_scale;
-            s.dy *= draw.footprint_scale;
+        if (draw.footprint_scale != glm::dvec2(1.0)) {  // SSAA: the sample's own cell, not the pixel
+            s.dx *= draw.footprint_scale.x;
+            s.dy *= draw.footprint_scale.y;
         }
         if (draw.debug_view == DebugView::uv)
             return glm::vec4(static_cast<float>(s.uv.x - std::floor(s.uv.x)), static_cast<float>(s.uv.y - std::floor(s.uv.y)),

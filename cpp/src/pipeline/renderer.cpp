@@ -368,7 +368,8 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             inputs[d].uv_interpolation = draws[d].state.interpolation;
             inputs[d].derivatives = settings.derivatives;
             inputs[d].debug_view = settings.debug_view;
-            if (settings.anti_aliasing == AntiAliasing::ssaa && S > 1) inputs[d].footprint_scale = 1.0 / std::sqrt(double(S));
+            if (settings.anti_aliasing == AntiAliasing::ssaa && S > 1)
+                inputs[d].footprint_scale = glm::dvec2(1.0 / result.pattern.columns, 1.0 / result.pattern.rows);
         }
     }
     std::vector<TileCounters> tile_counters(static_cast<std::size_t>(grid.count()));

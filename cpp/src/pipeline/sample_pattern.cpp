@@ -72,10 +72,13 @@ SamplePattern make_sample_pattern(PatternKind kind, int samples, std::uint64_t s
             add(224, 96);
             add(32, 160);
             add(160, 224);
+            p.columns = p.rows = 2;
             break;
         case PatternKind::grid:
         case PatternKind::stratified: {
             const int rows = grid_rows(samples), cols = samples / rows;
+            p.columns = cols;
+            p.rows = rows;
             std::uint64_t state = seed;
             for (int b = 0; b < rows; ++b)
                 for (int a = 0; a < cols; ++a) {

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
 #include "mipraster/pipeline/draw.hpp"
@@ -60,9 +61,10 @@ struct DrawInputs {
     Interpolation uv_interpolation = Interpolation::perspective;
     DerivativeMode derivatives = DerivativeMode::analytic;
     DebugView debug_view = DebugView::none;
-    /// Multiplies the uv derivatives: 1/√S under SSAA, where each of the S samples stands for a
-    /// 1/√S-pixel cell (as if rendered at √S× the resolution), else 1.
-    double footprint_scale = 1.0;
+    /// Multiplies the uv derivatives along screen x and y: under SSAA each sample stands for one
+    /// cell of its pattern, 1/columns × 1/rows pixel (as if rendered at that finer resolution),
+    /// so (1/columns, 1/rows); else (1, 1).
+    glm::dvec2 footprint_scale{1.0};
 };
 
 /// Triangles of one draw, in submission order: tris[indices[k]] for k < count.

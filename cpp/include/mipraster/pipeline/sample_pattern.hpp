@@ -24,6 +24,9 @@ PatternKind parse_pattern_kind(const std::string& name);
 struct SamplePattern {
     PatternKind kind = PatternKind::center;
     std::vector<std::int32_t> x, y;
+    /// The grid of cells the samples stand for (each sample one cell of 1/columns × 1/rows
+    /// pixel): columns × rows for grid and stratified, 2 × 2 for rotated, 1 × 1 for center.
+    int columns = 1, rows = 1;
 
     int count() const { return static_cast<int>(x.size()); }
     std::string to_string() const;
