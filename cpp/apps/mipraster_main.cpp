@@ -1,7 +1,7 @@
 // mipraster — the command-line renderer.
 //
 //   mipraster compare A B [--fail T] [--fail-fraction F] [--hard-fail H]
-//   mipraster bench [options]     (runs python3 -m mipraster.bench)
+//   mipraster bench [options]     (runs python3 -m mipraster.bench, see python_executable)
 //   mipraster stress [--full] [--json FILE] [--details]
 //   mipraster render [SCENE] -o OUT.png [--camera N] [--size WxH] [--spp N] [--aa ssaa|msaa] [--pattern NAME]
 //                    [--look-at EX,EY,EZ,TX,TY,TZ] [--fov DEG] [--threads N]
@@ -61,13 +61,12 @@ constexpr const char* kUsage =
     "             (a textured cube on a textured checker plane to the horizon):\n"
     "             mipraster render [SCENE] -o OUT [options]\n"
     "  compare    compare two images value by value and print a report (idiff style)\n"
-    "  bench      frame times against Mesa's llvmpipe on the shared benchmark scenes; runs\n"
-    "             `python3 -m mipraster.bench` (interpreter: $MIPRASTER_PYTHON, else python3),\n"
-    "             see `mipraster bench --help`\n"
-    "  stress     run the numerical stress suite (issue 6) and print one row per case:\n"
+    "  bench      frame times against Mesa's llvmpipe on the shared benchmark scenes; runs in\n"
+    "             Python like study (`python3 -m mipraster.bench`); mipraster bench --help\n"
+    "  stress     run the numerical stress suite and print one row per case:\n"
     "             what was tried, the figure measured, its bound, PASS/FAIL\n"
-  "  resize     resize an image with a reconstruction filter (in linear colour, widened when shrinking)\n"
-  "  synthesize grow a texture like a sample image (Efros & Leung non-parametric sampling)\n"
+    "  resize     resize an image with a reconstruction filter (in linear colour, widened when shrinking)\n"
+    "  synthesize grow a texture like a sample image (Efros & Leung non-parametric sampling)\n"
     "  study      error against run time of the quality knobs (samples, pattern, SSAA/MSAA,\n"
     "             texture filter, anisotropy, LOD bias): CSV, Markdown table and plot. It runs in\n"
     "             Python: the binary hands its arguments to `python3 -m mipraster.study` (the\n"
@@ -96,8 +95,8 @@ constexpr const char* kUsage =
     "  --lod-bias B          added to the level of detail (log2 texels per pixel)\n"
     "  --debug-view V        none, mip-level (a colour per mip level), uv (uv as colour)\n"
     "  --derivatives D       analytic (exact per sample) or quad (2x2 finite differences) [analytic]\n"
-  "  --resolve F           resolve filter: box (mean of the pixel's samples), tent, mitchell,\n"
-  "                        catmull-rom, lanczos3 (also weigh the samples of nearby pixels) [box]\n"
+    "  --resolve F           resolve filter: box (mean of the pixel's samples), tent, mitchell,\n"
+    "                        catmull-rom, lanczos3 (also weigh the samples of nearby pixels) [box]\n"
     "  --stats               print triangle, sample and per-stage time counts, and (spp >= 2)\n"
     "                        the estimated RMSE from two interleaved halves of the samples\n"
     "  --stats-json PATH     write the counts and times as JSON (- = stdout)\n"
@@ -119,18 +118,18 @@ constexpr const char* kUsage =
     "  --details             print the per-setting measurements under each row\n"
     "\n"
     "resize IN -o OUT --size WxH [options]: read any image, write .png (sRGB 8-bit) or .exr\n"
-  "  --filter F            box, tent, mitchell, catmull-rom, lanczos3          [mitchell]\n"
-  "  --threads N           worker threads, 0 = all cores                     [0]\n"
-  "\n"
-  "synthesize SAMPLE -o OUT --size WxH [options]: every output pixel is copied from the sample\n"
-  "  --window N            odd neighbourhood side, at most the sample's sides [11]\n"
-  "  --seed S              random seed; the same seed gives the same output   [0]\n"
-  "  --epsilon E           draw among matches within (1 + E) of the best      [0.1]\n"
-  "  --periodic            the sample tiles: its neighbourhoods wrap around its edges\n"
-  "  --tileable            make the output tile (its neighbourhoods wrap around)\n"
-  "  --threads N           worker threads, 0 = all cores                     [0]\n"
-  "\n"
-  "  mipraster --help | --version\n";
+    "  --filter F            box, tent, mitchell, catmull-rom, lanczos3          [mitchell]\n"
+    "  --threads N           worker threads, 0 = all cores                     [0]\n"
+    "\n"
+    "synthesize SAMPLE -o OUT --size WxH [options]: every output pixel is copied from the sample\n"
+    "  --window N            odd neighbourhood side, at most the sample's sides [11]\n"
+    "  --seed S              random seed; the same seed gives the same output   [0]\n"
+    "  --epsilon E           draw among matches within (1 + E) of the best      [0.1]\n"
+    "  --periodic            the sample tiles: its neighbourhoods wrap around its edges\n"
+    "  --tileable            make the output tile (its neighbourhoods wrap around)\n"
+    "  --threads N           worker threads, 0 = all cores                     [0]\n"
+    "\n"
+    "  mipraster --help | --version\n";
 
 struct UsageError : std::runtime_error {
     using std::runtime_error::runtime_error;

@@ -34,7 +34,7 @@ Image files (:func:`read_image`, :func:`write_image`, :meth:`RenderResult.save`)
 :func:`load_scene` reads OBJ and glTF scene files (geometry, colours, uvs, normals, base-colour
 textures with their samplers, cameras) through the same module.
 
-:func:`stress` runs the numerical stress suite (issue 6) and returns one :class:`StressRow` per
+:func:`stress` runs the numerical stress suite and returns one :class:`StressRow` per
 case (also ``mipraster stress`` on the command line).
 :func:`resample` resizes an image with a reconstruction filter (box, tent, Mitchell–Netravali,
 Catmull–Rom, Lanczos-3; widened when shrinking, in linear colour) and :func:`synthesize` grows a new

@@ -1,4 +1,4 @@
-"""The numerical stress suite (issue 6): :func:`stress` runs the twelve cases and returns one row each.
+"""The numerical stress suite: :func:`stress` runs the twelve cases and returns one row each.
 
 Each row says what was tried, the figure measured against an independent oracle (exact integer
 coverage, a double-precision clip-space ray cast, a double texture reference), the bound it must
