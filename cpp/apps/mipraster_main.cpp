@@ -243,6 +243,13 @@ void draw_progress(std::size_t done, std::size_t total) {
     std::fflush(stderr);
 }
 
+// "WxH" as two integers, unchecked beyond their format.
+std::pair<int, int> split_size(const std::string& text) {
+    const auto x = text.find('x');
+    if (x == std::string::npos) throw UsageError("--size: expected WxH (e.g. 1280x720), got '" + text + "'");
+    return {parse_int("--size width", text.substr(0, x)), parse_int("--size height", text.substr(x + 1))};
+}
+
 RenderOptions parse_render_options(const std::vector<std::string>& args) {
     RenderOptions o;
     o.settings.width = 1280;
@@ -258,11 +265,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
         if (a == "-o" || a == "--output") {
             o.output = value();
         } else if (a == "--size") {
-            const std::string& v = value();
-            const auto x = v.find('x');
-            if (x == std::string::npos) throw UsageError("--size: expected WxH (e.g. 1280x720), got '" + v + "'");
-            o.settings.width = parse_int("--size width", v.substr(0, x));
-            o.settings.height = parse_int("--size height", v.substr(x + 1));
+            // Only the format here: the renderer checks the range and names the dimension.
+            std::tie(o.settings.width, o.settings.height) = split_size(value());
         } else if (a == "--spp") {
             o.settings.samples = parse_int(a, value());
         } else if (a == "--aa") {
@@ -412,9 +416,7 @@ int run_render(const std::vector<std::string>& args) {
 
 // "WxH" with both in 1…limit.
 std::pair<int, int> parse_size(const std::string& text, int limit) {
-    const auto x = text.find('x');
-    if (x == std::string::npos) throw UsageError("--size: expected WxH (e.g. 256x256), got '" + text + "'");
-    const int w = parse_int("--size width", text.substr(0, x)), h = parse_int("--size height", text.substr(x + 1));
+    const auto [w, h] = split_size(text);
     if (w < 1 || h < 1 || w > limit || h > limit)
         throw UsageError("--size: " + text + " is out of range; expected 1 to " + std::to_string(limit) + " each");
     return {w, h};

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "mipraster/core/constants.hpp"
+#include "mipraster/core/splitmix.hpp"
 
 namespace mipraster {
 
@@ -15,14 +16,6 @@ int grid_rows(int samples) {
     for (int r = 1; r * r <= samples; ++r)
         if (samples % r == 0) rows = r;
     return rows;
-}
-
-// splitmix64: a small, well-mixed generator so a seed gives the same pattern everywhere.
-std::uint64_t splitmix64(std::uint64_t& state) {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "mipraster/core/constants.hpp"
+#include "mipraster/core/splitmix.hpp"
 #include "mipraster/core/thread_pool.hpp"
 
 namespace mipraster {
@@ -19,16 +20,10 @@ namespace {
 constexpr std::size_t kSynthesisPairsPerTask = 32768;
 static_assert(kSynthesisPairsPerTask > 0, "a task has work");
 
-// splitmix64: a small, fast generator whose sequence is the same on every platform (the standard
-// distributions are not), so a seed means the same output everywhere.
+// Seeded draws from splitmix64, the same on every platform.
 struct Random {
     std::uint64_t state;
-    std::uint64_t next() {
-        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
+    std::uint64_t next() { return splitmix64(state); }
     /// Uniform in [0, n) (multiply-shift; the bias is below 2^-32 for any n we use).
     std::size_t below(std::size_t n) {
         return static_cast<std::size_t>((static_cast<unsigned __int128>(next()) * n) >> 64);
