@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace mipraster {
@@ -13,6 +14,35 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // λ within this of an integer is taken as that integer (float derivatives carry ~1e-7 relative
 // error; log2 turns that into ~1e-7 absolute).
 constexpr double kLodSnap = 1e-6;
+
+// One RGBA texel in one SSE register. A GCC/Clang vector type: the same SSE2 instructions on
+// every x86-64, so results do not depend on the CPU (DESIGN.md §2.8).
+typedef float Texel __attribute__((vector_size(16)));
+
+inline Texel load(const glm::vec4& t) {
+    Texel r;
+    std::memcpy(&r, &t, sizeof r);
+    return r;
+}
+inline glm::vec4 to_vec4(Texel t) {
+    glm::vec4 r;
+    std::memcpy(&r, &t, sizeof r);
+    return r;
+}
+inline Texel splat(float x) { return Texel{x, x, x, x}; }
+// a + t·(b − a): equal a and b give back a exactly, whatever t is.
+inline Texel lerp(Texel a, Texel b, float t) { return a + splat(t) * (b - a); }
+
+// ⌊x⌋ and ⌈x⌉ of a finite x well inside the int range (callers bound x first): a truncation and a
+// compare, where std::floor is a library call on the x86-64 baseline.
+inline int floor_int(double x) {
+    const int i = static_cast<int>(x);
+    return i - (x < i);
+}
+inline int ceil_int(double x) {
+    const int i = static_cast<int>(x);
+    return i + (x > i);
+}
 
 // A texel-space coordinate moved by whole periods (repeat, mirror) or clamped just past the
 // edges (clamp, border), so that its floor and the indices next to it fit an int. No float
@@ -59,50 +89,47 @@ int wrap_index(int i, int n, WrapMode mode) {
     return -1;
 }
 
-glm::dvec4 fetch(const TextureLevel& level, int i, int j, const Sampler& s) {
+Texel fetch(const TextureLevel& level, int i, int j, const Sampler& s) {
     i = wrap_index(i, level.width, s.wrap_u);
     j = wrap_index(j, level.height, s.wrap_v);
-    if (i < 0 || j < 0) return glm::dvec4(s.border_color);
-    return glm::dvec4(level.at(i, j));
+    if (i < 0 || j < 0) return load(s.border_color);
+    return load(level.at(i, j));
 }
 
 // The seeds' nearest rule: the texel whose cell holds the point, i = ⌊u·w⌋.
-glm::dvec4 nearest(const TextureLevel& level, double u, double v, const Sampler& s) {
+Texel nearest(const TextureLevel& level, double u, double v, const Sampler& s) {
     const double x = reduce(u * level.width, level.width, s.wrap_u);
     const double y = reduce(v * level.height, level.height, s.wrap_v);
-    return fetch(level, static_cast<int>(std::floor(x)), static_cast<int>(std::floor(y)), s);
+    return fetch(level, floor_int(x), floor_int(y), s);
 }
 
-// The bilinear blend of four texels a b / c d at fractions (ax, ay). Written as lerps so equal
-// neighbours give back their value exactly.
-inline glm::dvec4 lerp_quad(const glm::dvec4& a, const glm::dvec4& b, const glm::dvec4& c, const glm::dvec4& d,
-                            double ax, double ay) {
-    const glm::dvec4 top = a + ax * (b - a), bottom = c + ax * (d - c);
-    return top + ay * (bottom - top);
+// The bilinear blend of four texels a b / c d at fractions (ax, ay).
+inline Texel lerp_quad(Texel a, Texel b, Texel c, Texel d, float ax, float ay) {
+    return lerp(lerp(a, b, ax), lerp(c, d, ax), ay);
 }
 
 // The quad at (i, j) when part of it lies outside the texture: each texel wrapped on its own.
 // Out of line, so the in-range path below stays small enough to inline into the filter loops.
-[[gnu::noinline]] glm::dvec4 bilinear_wrapped(const TextureLevel& level, int i, int j, double ax, double ay,
-                                              const Sampler& s) {
+[[gnu::noinline]] Texel bilinear_wrapped(const TextureLevel& level, int i, int j, float ax, float ay,
+                                         const Sampler& s) {
     return lerp_quad(fetch(level, i, j, s), fetch(level, i + 1, j, s), fetch(level, i, j + 1, s),
                      fetch(level, i + 1, j + 1, s), ax, ay);
 }
 
-// Bilinear between the four nearest texel centres, i = ⌊u·w − ½⌋.
-inline glm::dvec4 bilinear(const TextureLevel& level, double u, double v, const Sampler& s) {
+// Bilinear between the four nearest texel centres, i = ⌊u·w − ½⌋. Positions and fractions are
+// found in double (so large textures and far repeats keep their sub-texel phase); the texels
+// are blended in float.
+inline Texel bilinear(const TextureLevel& level, double u, double v, const Sampler& s) {
     const double x = reduce(u * level.width, level.width, s.wrap_u) - 0.5;
     const double y = reduce(v * level.height, level.height, s.wrap_v) - 0.5;
-    const double fx = std::floor(x), fy = std::floor(y);
-    const int i = static_cast<int>(fx), j = static_cast<int>(fy);
-    const double ax = x - fx, ay = y - fy;
+    const int i = floor_int(x), j = floor_int(y);
+    const float ax = static_cast<float>(x - i), ay = static_cast<float>(y - j);
     if (i < 0 || j < 0 || i + 1 >= level.width || j + 1 >= level.height) return bilinear_wrapped(level, i, j, ax, ay, s);
     const glm::vec4* row = &level.at(i, j);  // no wrapping: most lookups
-    return lerp_quad(glm::dvec4(row[0]), glm::dvec4(row[1]), glm::dvec4(row[level.width]),
-                     glm::dvec4(row[level.width + 1]), ax, ay);
+    return lerp_quad(load(row[0]), load(row[1]), load(row[level.width]), load(row[level.width + 1]), ax, ay);
 }
 
-glm::dvec4 texel_filter(const TextureLevel& level, double u, double v, TexelFilter filter, const Sampler& s) {
+Texel texel_filter(const TextureLevel& level, double u, double v, TexelFilter filter, const Sampler& s) {
     return filter == TexelFilter::nearest ? nearest(level, u, v, s) : bilinear(level, u, v, s);
 }
 
@@ -110,124 +137,176 @@ glm::dvec4 texel_filter(const TextureLevel& level, double u, double v, TexelFilt
 struct Footprint {
     double ux, vx, uy, vy;  // ∂(u·w, v·h)/∂x and /∂y
     bool finite() const { return std::isfinite(ux) && std::isfinite(vx) && std::isfinite(uy) && std::isfinite(vy); }
-    // Plain sqrt of the sum of squares (hypot is much slower): a length past ~1e154 overflows to
-    // inf, which selects the coarsest level as the true length would.
-    double length_x() const { return std::sqrt(ux * ux + vx * vx); }
-    double length_y() const { return std::sqrt(uy * uy + vy * vy); }
+    // Squared lengths: from float derivatives (< 2^128 · 2^16 texels) they stay finite in double.
+    double length2_x() const { return ux * ux + vx * vx; }
+    double length2_y() const { return uy * uy + vy * vy; }
 };
 
 Footprint texel_footprint(const TextureView& t, glm::vec2 dx, glm::vec2 dy) {
     return {double(dx.x) * t.width(), double(dx.y) * t.height(), double(dy.x) * t.width(), double(dy.y) * t.height()};
 }
 
-// λ from a footprint size ρ in texels: log2 ρ + bias, clamped; non-finite ρ → the coarsest level.
-double lod_from_size(double rho, const Sampler& s, int levels) {
-    double lambda = std::isfinite(rho) ? std::log2(rho) + s.lod_bias : kInf;  // log2(0) = −inf
+// log2 ρ from ρ²; a non-finite ρ² gives +∞ (the coarsest level).
+double log2_size(double rho2) { return rho2 < kInf ? 0.5 * std::log2(rho2) : kInf; }  // log2(0) = −inf
+
+// λ from log2 ρ: + bias, snapped to an integer within kLodSnap, clamped to [min_lod, max_lod]
+// and [0, levels − 1].
+double lod_from_log2_size(double log2_rho, const Sampler& s, int levels) {
+    // Bounded first (the snap converts to int); outside [−1, levels] the clamps below decide alone.
+    double lambda = std::clamp(log2_rho + s.lod_bias, -1.0, double(levels));
     // Derivatives arrive as floats: a footprint of exactly 2^k texels comes out a few ulps short.
     // Snap such λ to the integer, so it reads one level, not two (the other at weight ~1e-8).
-    if (std::abs(lambda - std::nearbyint(lambda)) < kLodSnap) lambda = std::nearbyint(lambda);
+    const int k = floor_int(lambda + 0.5);
+    if (std::abs(lambda - k) < kLodSnap) lambda = k;
     lambda = std::clamp(lambda, double(s.min_lod), double(s.max_lod));
     return std::clamp(lambda, 0.0, double(levels - 1));  // [0, levels − 1] even for a negative min_lod
 }
 
+// True when ρ² ≤ 1 is sure to magnify without a log2: no bias and no positive min_lod.
+bool plainly_magnifies(double rho2, const Sampler& s) {
+    return rho2 <= 1.0 && s.lod_bias == 0.0f && s.min_lod <= 0.0f;
+}
+
+double isotropic_lod(const Footprint& f, const Sampler& s, int levels) {
+    if (!f.finite()) return lod_from_log2_size(kInf, s, levels);
+    const double rho2 = std::max(f.length2_x(), f.length2_y());
+    if (plainly_magnifies(rho2, s)) return 0.0;
+    return lod_from_log2_size(log2_size(rho2), s, levels);
+}
+
 // Minification within the mip chain at λ > 0 with the sampler's min and mip filters.
-glm::dvec4 mip_filter(const TextureView& t, double u, double v, double lambda, const Sampler& s) {
+Texel mip_filter(const TextureView& t, double u, double v, double lambda, const Sampler& s) {
     switch (s.mip_filter) {
         case MipFilter::none: return texel_filter(t.level(0), u, v, s.min_filter, s);
         case MipFilter::nearest: {
             // GL's choice: level ⌈λ + ½⌉ − 1, so λ ≤ ½ stays on level 0.
-            const int k = std::clamp(static_cast<int>(std::ceil(lambda + 0.5)) - 1, 0, t.level_count() - 1);
+            const int k = std::clamp(ceil_int(lambda + 0.5) - 1, 0, t.level_count() - 1);
             return texel_filter(t.level(k), u, v, s.min_filter, s);
         }
         case MipFilter::linear: {
             const int k = std::min(static_cast<int>(lambda), t.level_count() - 1);
             const double f = lambda - k;
-            const glm::dvec4 a = texel_filter(t.level(k), u, v, s.min_filter, s);
+            const Texel a = texel_filter(t.level(k), u, v, s.min_filter, s);
             if (f <= 0.0 || k + 1 >= t.level_count()) return a;
-            return a + f * (texel_filter(t.level(k + 1), u, v, s.min_filter, s) - a);
+            return lerp(a, texel_filter(t.level(k + 1), u, v, s.min_filter, s), static_cast<float>(f));
         }
     }
-    return glm::dvec4(0.0);
+    return splat(0.0f);
 }
 
 // Isotropic: one mip lookup at λ, or the magnification filter when λ ≤ 0.
-glm::dvec4 isotropic(const TextureView& t, double u, double v, double lambda, const Sampler& s) {
+Texel isotropic(const TextureView& t, double u, double v, double lambda, const Sampler& s) {
     if (lambda <= 0.0) return texel_filter(t.level(0), u, v, s.mag_filter, s);
     return mip_filter(t, u, v, lambda, s);
-}
-
-double isotropic_lod(const Footprint& f, const Sampler& s, int levels) {
-    if (!f.finite()) return lod_from_size(kInf, s, levels);
-    return lod_from_size(std::max(f.length_x(), f.length_y()), s, levels);
 }
 
 // EXT_texture_filter_anisotropic: N = min(⌈Pmax/Pmin⌉, max anisotropy) probes spaced evenly
 // along the major derivative over the pixel, each a mip lookup at λ = log2(Pmax/N).
 struct AnisoProbes {
+    bool magnifies = false;     // isotropic λ ≤ 0: one magnification lookup instead
     int count = 1;
     double lambda = 0.0;
     double du = 0.0, dv = 0.0;  // the major derivative in uv
 };
 
+constexpr int kMostProbes = 1024;
+// log2 N for every probe count N (one log2 call saved per lookup).
+const std::array<double, kMostProbes + 1> kLog2Count = [] {
+    std::array<double, kMostProbes + 1> table{};
+    for (int n = 1; n <= kMostProbes; ++n) table[n] = std::log2(double(n));
+    return table;
+}();
+
 AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const Sampler& s, int levels) {
     AnisoProbes p;
     if (!f.finite()) {
-        p.lambda = lod_from_size(kInf, s, levels);
+        p.lambda = lod_from_log2_size(kInf, s, levels);
+        p.magnifies = p.lambda <= 0.0;
         return p;
     }
-    const double px = f.length_x(), py = f.length_y();
-    const double pmax = std::max(px, py), pmin = std::min(px, py);
+    const double px2 = f.length2_x(), py2 = f.length2_y();
+    const double pmax2 = std::max(px2, py2), pmin2 = std::min(px2, py2);
+    if (plainly_magnifies(pmax2, s)) {
+        p.magnifies = true;
+        return p;
+    }
+    // One log2 serves both λs: the isotropic one (log2 Pmax) and the probes' (log2 Pmax − log2 N).
+    const double log2_pmax = log2_size(pmax2);
+    if (lod_from_log2_size(log2_pmax, s, levels) <= 0.0) {
+        p.magnifies = true;
+        return p;
+    }
     // max_anisotropy is any finite float ≥ 1: bound it before the int conversion (UB beyond 2³¹).
-    constexpr double kMostProbes = 1024.0;
-    const int max_n = static_cast<int>(std::clamp(double(s.max_anisotropy), 1.0, kMostProbes));
-    const double ratio = pmin > 0.0 ? std::ceil(pmax / pmin) : kInf;
-    p.count = ratio < max_n ? std::max(1, static_cast<int>(ratio)) : max_n;
-    p.lambda = lod_from_size(pmax / p.count, s, levels);
-    const glm::vec2 major = px >= py ? dx : dy;
+    const int max_n = static_cast<int>(std::clamp(double(s.max_anisotropy), 1.0, double(kMostProbes)));
+    // ⌈Pmax/Pmin⌉ from the squares; Pmin = 0 gives ∞ or NaN, both max_n.
+    const double ratio2 = pmax2 / pmin2;
+    p.count = ratio2 < double(max_n) * max_n ? std::max(1, ceil_int(std::sqrt(ratio2))) : max_n;
+    p.lambda = lod_from_log2_size(p.count == 1 ? log2_pmax : log2_pmax - kLog2Count[p.count], s, levels);
+    const glm::vec2 major = px2 >= py2 ? dx : dy;
     p.du = major.x;
     p.dv = major.y;
     return p;
 }
 
-// The mean of p.count probes along the major axis, each a lookup on `fine`, blended towards
-// `coarse` (when set) by `blend`. The filter is a template argument so that bilinear inlines
-// into the loop: this loop is most of an anisotropic lookup's time.
+// The mean of the p.count probes on one level, u + ((i + ½)/N − ½)·(du, dv) for i < N. Kept as the
+// first probe plus the mean difference from it, so a constant texture gives back its value
+// exactly. The filter is a template argument so that it inlines into the loops: they are most of
+// an anisotropic lookup's time.
 template <TexelFilter kFilter>
-glm::dvec4 anisotropic_probes(const AnisoProbes& p, double u, double v, const TextureLevel* fine,
-                              const TextureLevel* coarse, double blend, const Sampler& s) {
-    const auto filter = [&s](const TextureLevel& level, double pu, double pv) {
+Texel probe_mean(const AnisoProbes& p, double u, double v, const TextureLevel& level, const Sampler& s) {
+    const double step = 1.0 / p.count;
+    if (kFilter == TexelFilter::linear) {
+        // Bilinear quads at x = u·w − ½ + o·du·w: when the centre and both end quads lie inside
+        // the level (so do all between: rounding is monotonic), no probe wraps, and positions
+        // step along the line with neither wrapping nor floor.
+        const double cx = u * level.width, cy = v * level.height;
+        const double sx = p.du * level.width, sy = p.dv * level.height;
+        const double x0 = cx - 0.5 + (0.5 * step - 0.5) * sx, y0 = cy - 0.5 + (0.5 * step - 0.5) * sy;
+        const double x1 = x0 + (p.count - 1) * step * sx, y1 = y0 + (p.count - 1) * step * sy;
+        const double last_x = level.width - 1, last_y = level.height - 1;
+        if (std::min(x0, x1) >= 0.0 && std::max(x0, x1) < last_x && std::min(y0, y1) >= 0.0 &&
+            std::max(y0, y1) < last_y) {
+            const std::size_t w = level.width;
+            const auto quad = [&](int k) {
+                const double x = x0 + k * step * sx, y = y0 + k * step * sy;
+                const int i = static_cast<int>(x), j = static_cast<int>(y);  // x, y ≥ 0: truncation is floor
+                const glm::vec4* q = &level.texels[j * w + i];
+                return lerp_quad(load(q[0]), load(q[1]), load(q[w]), load(q[w + 1]), static_cast<float>(x - i),
+                                 static_cast<float>(y - j));
+            };
+            const Texel first = quad(0);
+            Texel difference = splat(0.0f);
+            for (int k = 1; k < p.count; ++k) difference += quad(k) - first;
+            return first + difference * splat(static_cast<float>(step));
+        }
+    }
+    const auto probe = [&](int k) {
+        const double o = (k + 0.5) * step - 0.5;
+        const double pu = u + o * p.du, pv = v + o * p.dv;
         return kFilter == TexelFilter::linear ? bilinear(level, pu, pv, s) : nearest(level, pu, pv, s);
     };
-    glm::dvec4 sum(0.0);
-    for (int i = 0; i < p.count; ++i) {
-        const double o = (i + 0.5) / p.count - 0.5;
-        const double pu = u + o * p.du, pv = v + o * p.dv;
-        glm::dvec4 probe = filter(*fine, pu, pv);
-        if (coarse) probe += blend * (filter(*coarse, pu, pv) - probe);
-        sum += probe;
-    }
-    return sum / double(p.count);
+    const Texel first = probe(0);
+    Texel difference = splat(0.0f);
+    for (int k = 1; k < p.count; ++k) difference += probe(k) - first;
+    return first + difference * splat(static_cast<float>(step));
 }
 
-glm::dvec4 anisotropic(const TextureView& t, double u, double v, const Footprint& f, glm::vec2 dx, glm::vec2 dy,
-                       const Sampler& s) {
-    if (isotropic_lod(f, s, t.level_count()) <= 0.0) return texel_filter(t.level(0), u, v, s.mag_filter, s);
+Texel anisotropic(const TextureView& t, double u, double v, const Footprint& f, glm::vec2 dx, glm::vec2 dy,
+                  const Sampler& s) {
     const AnisoProbes p = aniso_probes(f, dx, dy, s, t.level_count());
+    if (p.magnifies) return texel_filter(t.level(0), u, v, s.mag_filter, s);
     if (p.count == 1) return isotropic(t, u, v, p.lambda, s);
+    const auto mean = [&](int k) {
+        if (s.min_filter == TexelFilter::linear) return probe_mean<TexelFilter::linear>(p, u, v, t.level(k), s);
+        return probe_mean<TexelFilter::nearest>(p, u, v, t.level(k), s);
+    };
     // The levels and the blend weight are the same for every probe (what mip_filter would pick).
-    const TextureLevel* fine = &t.level(0);
-    const TextureLevel* coarse = nullptr;
-    double blend = 0.0;
-    if (p.lambda > 0.0 && s.mip_filter == MipFilter::nearest) {
-        fine = &t.level(std::clamp(static_cast<int>(std::ceil(p.lambda + 0.5)) - 1, 0, t.level_count() - 1));
-    } else if (p.lambda > 0.0 && s.mip_filter == MipFilter::linear) {
-        const int k = std::min(static_cast<int>(p.lambda), t.level_count() - 1);
-        fine = &t.level(k);
-        blend = p.lambda - k;
-        if (blend > 0.0 && k + 1 < t.level_count()) coarse = &t.level(k + 1);
-    }
-    if (s.min_filter == TexelFilter::linear) return anisotropic_probes<TexelFilter::linear>(p, u, v, fine, coarse, blend, s);
-    return anisotropic_probes<TexelFilter::nearest>(p, u, v, fine, coarse, blend, s);
+    if (p.lambda <= 0.0 || s.mip_filter == MipFilter::none) return mean(0);
+    if (s.mip_filter == MipFilter::nearest) return mean(std::clamp(ceil_int(p.lambda + 0.5) - 1, 0, t.level_count() - 1));
+    const int k = std::min(static_cast<int>(p.lambda), t.level_count() - 1);
+    const Texel fine = mean(k);
+    if (!(p.lambda > k) || k + 1 >= t.level_count()) return fine;
+    return lerp(fine, mean(k + 1), static_cast<float>(p.lambda - k));
 }
 
 // exp(−α·q) for q = r² in [0, 1], tabulated (linear interpolation between entries).
@@ -248,7 +327,7 @@ const GaussianTable kGaussian;
 // Heckbert's EWA: the pixel's footprint ellipse (covariance J·Jᵀ of the screen → texel map,
 // the minor axis widened to 1/max_anisotropy of the major and to one texel of the chosen
 // level), weighted by a Gaussian of the screen distance, summed over the texels inside.
-glm::dvec4 ewa(const TextureView& t, double u, double v, const Footprint& f, const Sampler& s) {
+Texel ewa(const TextureView& t, double u, double v, const Footprint& f, const Sampler& s) {
     const int levels = t.level_count();
     if (isotropic_lod(f, s, levels) <= 0.0) return texel_filter(t.level(0), u, v, s.mag_filter, s);
     if (!f.finite()) return bilinear(t.level(levels - 1), u, v, s);
@@ -296,8 +375,11 @@ glm::dvec4 ewa(const TextureView& t, double u, double v, const Footprint& f, con
     const double cx = centre(u * level.width, level.width, std::sqrt(sxx), s.wrap_u);
     const double cy = centre(v * level.height, level.height, std::sqrt(syy), s.wrap_v);
     const double ey = std::sqrt(syy);
-    const int j0 = static_cast<int>(std::ceil(cy - ey - 0.5)), j1 = static_cast<int>(std::floor(cy + ey - 0.5));
-    glm::dvec4 sum(0.0);
+    const int j0 = ceil_int(cy - ey - 0.5), j1 = floor_int(cy + ey - 0.5);
+    // The sum is kept relative to the texel at the centre, so a constant texture gives back its
+    // value exactly.
+    const Texel origin = fetch(level, floor_int(cx), floor_int(cy), s);
+    Texel sum = splat(0.0f);
     double weight = 0.0;
     for (int j = j0; j <= j1; ++j) {
         const double dy = j + 0.5 - cy;
@@ -307,23 +389,27 @@ glm::dvec4 ewa(const TextureView& t, double u, double v, const Footprint& f, con
         if (disc < 0.0) continue;
         const double root = std::sqrt(disc);
         const double x_lo = cx + (-b - root) / (2.0 * qa), x_hi = cx + (-b + root) / (2.0 * qa);
-        const int i0 = static_cast<int>(std::ceil(x_lo - 0.5)), i1 = static_cast<int>(std::floor(x_hi - 0.5));
+        const int i0 = ceil_int(x_lo - 0.5), i1 = floor_int(x_hi - 0.5);
+        // A row inside the texture is read directly; others texel by texel through the wrap modes.
+        const bool inside = j >= 0 && j < level.height && i0 >= 0 && i1 < level.width;
+        const glm::vec4* row = inside ? &level.at(0, j) : nullptr;
         for (int i = i0; i <= i1; ++i) {
             const double dx = i + 0.5 - cx;
             const double q = qa * dx * dx + qb * dx * dy + qc * dy * dy;
             if (q > 1.0) continue;
             const double w = kGaussian(std::max(q, 0.0));
-            sum += w * fetch(level, i, j, s);
+            const Texel texel = inside ? load(row[i]) : fetch(level, i, j, s);
+            sum += splat(static_cast<float>(w)) * (texel - origin);
             weight += w;
         }
     }
     if (!(weight > 0.0)) return bilinear(level, u, v, s);
-    return sum / weight;
+    return origin + sum * splat(static_cast<float>(1.0 / weight));
 }
 
 // The notes' summed-area table: the exact mean over the bounding box of the pixel's footprint
 // parallelogram (the texture taken piecewise constant), on the table's level.
-glm::dvec4 summed_area(const TextureView& t, double u, double v, const Footprint& f, const Sampler& s) {
+Texel summed_area(const TextureView& t, double u, double v, const Footprint& f, const Sampler& s) {
     const int levels = t.level_count();
     const double lambda = isotropic_lod(f, s, levels);
     if (lambda <= 0.0) return texel_filter(t.level(0), u, v, s.mag_filter, s);
@@ -340,31 +426,30 @@ glm::dvec4 summed_area(const TextureView& t, double u, double v, const Footprint
     const SummedAreaTable& table = t.summed_area_table();
     const double cx = centre(u * level.width, level.width, hx, s.wrap_u);
     const double cy = centre(v * level.height, level.height, hy, s.wrap_v);
-    return table.box_mean(cx - hx, cy - hy, cx + hx, cy + hy, s);
+    return load(glm::vec4(table.box_mean(cx - hx, cy - hy, cx + hx, cy + hy, s)));
 }
 
 }  // namespace
 
 double texture_lod(const TextureView& t, const Sampler& s, glm::vec2 dx, glm::vec2 dy) {
     const Footprint f = texel_footprint(t, dx, dy);
-    const double lambda = isotropic_lod(f, s, t.level_count());
+    if (s.footprint != FootprintFilter::anisotropic) return isotropic_lod(f, s, t.level_count());
     // Anisotropic minification reads its probes at log2(Pmax/N); magnification is the same for all.
-    if (s.footprint == FootprintFilter::anisotropic && lambda > 0.0)
-        return aniso_probes(f, dx, dy, s, t.level_count()).lambda;
-    return lambda;
+    const AnisoProbes p = aniso_probes(f, dx, dy, s, t.level_count());
+    return p.magnifies ? 0.0 : p.lambda;
 }
 
 glm::vec4 sample_texture(const TextureView& t, const Sampler& s, glm::vec2 uv, glm::vec2 dx, glm::vec2 dy) {
     if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return s.border_color;
     const double u = uv.x, v = uv.y;
     // One filter on level 0 whatever λ is: no need to compute it.
-    if (!s.needs_derivatives()) return glm::vec4(texel_filter(t.level(0), u, v, s.mag_filter, s));
+    if (!s.needs_derivatives()) return to_vec4(texel_filter(t.level(0), u, v, s.mag_filter, s));
     const Footprint f = texel_footprint(t, dx, dy);
     switch (s.footprint) {
-        case FootprintFilter::isotropic: return glm::vec4(isotropic(t, u, v, isotropic_lod(f, s, t.level_count()), s));
-        case FootprintFilter::anisotropic: return glm::vec4(anisotropic(t, u, v, f, dx, dy, s));
-        case FootprintFilter::ewa: return glm::vec4(ewa(t, u, v, f, s));
-        case FootprintFilter::sat: return glm::vec4(summed_area(t, u, v, f, s));
+        case FootprintFilter::isotropic: return to_vec4(isotropic(t, u, v, isotropic_lod(f, s, t.level_count()), s));
+        case FootprintFilter::anisotropic: return to_vec4(anisotropic(t, u, v, f, dx, dy, s));
+        case FootprintFilter::ewa: return to_vec4(ewa(t, u, v, f, s));
+        case FootprintFilter::sat: return to_vec4(summed_area(t, u, v, f, s));
     }
     return s.border_color;
 }

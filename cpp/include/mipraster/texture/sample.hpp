@@ -28,8 +28,10 @@ double texture_lod(const TextureView& texture, const Sampler& sampler, glm::vec2
 
 /// The filtered, premultiplied linear RGBA colour at uv (0,0 = top-left of the first row) for
 /// a pixel whose uv changes by duv_dx, duv_dy per pixel step. A non-finite uv returns the border
-/// colour. Arithmetic is in double and rounded once, so a constant texture returns its value
-/// exactly for every footprint.
+/// colour. Positions, fractions and λ are computed in double; texels are blended in float, four
+/// channels at once (SSE2 on every x86-64, so the result does not depend on the CPU). Means are
+/// kept relative to one of their terms, so a constant texture returns its value exactly for
+/// every footprint.
 glm::vec4 sample_texture(const TextureView& texture, const Sampler& sampler, glm::vec2 uv, glm::vec2 duv_dx,
                          glm::vec2 duv_dy);
 
