@@ -10,6 +10,7 @@
 #include <pybind11/stl.h>
 
 #include "common.hpp"
+#include "mipraster/core/memory_limit.hpp"
 #include "mipraster/io/image_io.hpp"
 #include "mipraster/io/scene_file.hpp"
 
@@ -159,6 +160,11 @@ PYBIND11_MODULE(_image, m) {
           "Writes (H, W, C) float32 (C = 1, 3 or 4; 4 = linear premultiplied RGBA) or (H, W): .png is sRGB\n"
           "8-bit with straight alpha (1 channel: plain grey), .exr is linear float as given. ValueError for\n"
           "another extension or a malformed image, OSError (with .filename) when the file cannot be written.");
+
+    // This module links its own copy of the core, memory limit included: the Python layer hands
+    // it the limit set through _core before each call.
+    m.def("set_memory_limit", [](std::uint64_t bytes) { mipraster::set_memory_limit(bytes); }, py::arg("bytes"),
+          "Sets this module's copy of the memory limit (mipraster.set_memory_limit sets both).");
 
     using mipraster::NamedCamera;
     py::class_<NamedCamera>(m, "NamedCamera",

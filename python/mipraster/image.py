@@ -20,9 +20,12 @@ PathLike = Union[str, "os.PathLike[str]"]
 
 
 def _image_module() -> ModuleType:
-    """The OpenImageIO-backed extension module, loaded on first use."""
+    """The OpenImageIO-backed extension module, loaded on first use, with the current memory
+    limit (it links its own copy of the core, so the limit set through _core is passed on)."""
     from . import _image
+    from ._core import memory_limit
 
+    _image.set_memory_limit(memory_limit())
     return _image
 
 

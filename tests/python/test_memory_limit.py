@@ -2,6 +2,7 @@
 above it raise MemoryLimitError (a ValueError and a MemoryError) giving the estimate and the limit,
 before anything large is allocated."""
 import re
+import warnings
 
 import numpy as np
 import pytest
@@ -70,3 +71,35 @@ def test_rasterize_and_texture_refused(limit):
         mr.rasterize(np.array([[-1, -1, 0, 1], [1, -1, 0, 1], [0, 1, 0, 1]], np.float32), [[0, 1, 2]], 1000, 1000)
     with pytest.raises(mr.MemoryLimitError, match=r"texture 'wall' \(512x512, RGBA float with its mip chain\) needs 5.33 MiB"):
         mr.Texture(np.zeros((512, 512, 4), np.uint8), name="wall")
+
+
+def test_image_read_refused_before_decoding(limit, tmp_path):
+    # An image file's header gives its size: reading it is refused above the limit, with the
+    # size in the message, and goes ahead at the estimate (stored channels, then RGBA float).
+    path = tmp_path / "grey.png"
+    mr.write_image(path, np.full((300, 200, 4), 0.5, np.float32))
+    limit(1 << 16)
+    with pytest.raises(mr.MemoryLimitError, match=r"reading '.*grey\.png' \(200x300x4\) needs"):
+        mr.read_image(path)
+    needed = 200 * 300 * 4 * 5 + 200 * 300 * 16
+    limit(needed)
+    assert mr.read_image(path).shape == (300, 200, 4)
+    limit(needed - 1)
+    with pytest.raises(mr.MemoryLimitError):
+        mr.read_image(path)
+
+
+def test_scene_file_textures_within_the_limit(limit, tmp_path):
+    # Scene files load in the OpenImageIO module, which has its own copy of the limit: the limit
+    # set here reaches it too (the texture image is refused while reading the scene).
+    mr.write_image(tmp_path / "big.png", np.full((400, 400, 3), 0.5, np.float32))
+    (tmp_path / "quad.mtl").write_text("newmtl m\nKd 1 1 1\nmap_Kd big.png\n")
+    (tmp_path / "quad.obj").write_text("mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                                       "usemtl m\nf 1/1 2/2 3/3\n")
+    limit(1 << 20)
+    with pytest.warns(UserWarning, match="big.png"):
+        mr.load_scene(tmp_path / "quad.obj")
+    limit(0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mr.load_scene(tmp_path / "quad.obj")

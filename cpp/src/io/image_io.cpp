@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "mipraster/core/colour.hpp"
+#include "mipraster/core/memory_limit.hpp"
 
 namespace mipraster {
 namespace {
@@ -130,6 +131,10 @@ Image decode_image(OIIO::ImageInput& in, const std::string& name, const ImageRea
     if (std::uint64_t(w) * std::uint64_t(h) > kMaxReadPixels)
         throw std::runtime_error("read_image: '" + name + "' is too large (" + std::to_string(w) + "x" +
                                  std::to_string(h) + " pixels; at most " + std::to_string(kMaxReadPixels) + ")");
+    // The stored channels as float (and as bytes first for 8-bit files), then RGBA float.
+    const std::uint64_t pixels = std::uint64_t(w) * std::uint64_t(h);
+    check_memory(values * (sizeof(float) + 1) + pixels * 4 * sizeof(float),
+                 "reading '" + name + "' (" + std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(nch) + ")");
 
     // Read every channel as float in [0, 1] (integers) or as stored (floats).
     const OIIO::TypeDesc stored = spec.format;
