@@ -256,10 +256,13 @@ template <TexelFilter kFilter>
 Texel probe_mean(const AnisoProbes& p, double u, double v, const TextureLevel& level, const Sampler& s) {
     const double step = 1.0 / p.count;
     if (kFilter == TexelFilter::linear) {
-        // Bilinear quads at x = u·w − ½ + o·du·w: when the centre and both end quads lie inside
-        // the level (so do all between: rounding is monotonic), no probe wraps, and positions
-        // step along the line with neither wrapping nor floor.
-        const double cx = u * level.width, cy = v * level.height;
+        // Bilinear quads at x = u·w − ½ + o·du·w: when both end quads lie inside the level (so do
+        // all between: rounding is monotonic), no probe wraps, and positions step along the line
+        // with neither wrapping nor floor. Repeat and mirror first move the centre by whole
+        // periods (each probe would be moved alike); clamp and border do not move it.
+        const auto periodic = [](WrapMode mode) { return mode == WrapMode::repeat || mode == WrapMode::mirror; };
+        const double cx = periodic(s.wrap_u) ? reduce(u * level.width, level.width, s.wrap_u) : u * level.width;
+        const double cy = periodic(s.wrap_v) ? reduce(v * level.height, level.height, s.wrap_v) : v * level.height;
         const double sx = p.du * level.width, sy = p.dv * level.height;
         const double x0 = cx - 0.5 + (0.5 * step - 0.5) * sx, y0 = cy - 0.5 + (0.5 * step - 0.5) * sy;
         const double x1 = x0 + (p.count - 1) * step * sx, y1 = y0 + (p.count - 1) * step * sy;
