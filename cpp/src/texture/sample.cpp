@@ -232,7 +232,9 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
     }
     // One log2 serves both λs: the isotropic one (log2 Pmax) and the probes' (log2 Pmax − log2 N).
     const double log2_pmax = log2_size(pmax2);
-    if (lod_from_log2_size(log2_pmax, s, levels) <= 0.0) {
+    // Surely minifying (λ > 0 after snapping and clamping) without working λ out; else ask.
+    const bool minifies = log2_pmax + s.lod_bias > kLodSnap && s.max_lod > 0.0f && levels > 1;
+    if (!minifies && lod_from_log2_size(log2_pmax, s, levels) <= 0.0) {
         p.magnifies = true;
         return p;
     }

@@ -5,11 +5,6 @@
 
 namespace mipraster {
 
-bool Sampler::needs_derivatives() const {
-    // λ only chooses between the magnification and minification filters when they differ.
-    return mip_filter != MipFilter::none || footprint != FootprintFilter::isotropic || mag_filter != min_filter;
-}
-
 bool Sampler::uses_mip_levels() const {
     return mip_filter != MipFilter::none || footprint == FootprintFilter::ewa || footprint == FootprintFilter::sat;
 }

@@ -209,13 +209,16 @@ TextureView::TextureView(const Texture& texture) : data_(texture.data_.get()) {
     std::lock_guard<std::mutex> lock(data_->mutex);
     ++data_->pins;
     data_->last_pinned = tick();
+    base_ = &data_->base;
+    published_ = data_->levels.data();
     width_ = data_->base.width;
     height_ = data_->base.height;
     levels_ = data_->level_count;
 }
 
 TextureView::TextureView(TextureView&& other) noexcept
-    : data_(other.data_), width_(other.width_), height_(other.height_), levels_(other.levels_) {
+    : data_(other.data_), base_(other.base_), published_(other.published_), width_(other.width_),
+      height_(other.height_), levels_(other.levels_) {
     other.data_ = nullptr;
 }
 
@@ -228,7 +231,7 @@ TextureView::~TextureView() {
     TextureCache::global().evict_if_over_budget();  // what this view pinned may now go
 }
 
-const TextureLevel& TextureView::level(int k) const {
+const TextureLevel& TextureView::build_level(int k) const {
     if (k < 0 || k >= levels_)
         throw std::out_of_range("texture '" + data_->name + "': level " + std::to_string(k) + " does not exist (0.." +
                                 std::to_string(levels_ - 1) + ")");

@@ -44,8 +44,12 @@ struct Sampler {
     float lod_bias = 0.0f;          ///< added to λ before clamping
     float min_lod = 0.0f, max_lod = 1000.0f;
 
-    /// True when a lookup depends on the uv derivatives (some filter varies with λ).
-    bool needs_derivatives() const;
+    /// True when a lookup depends on the uv derivatives (some filter varies with λ). Inline: every
+    /// lookup asks.
+    bool needs_derivatives() const {
+        // λ only chooses between the magnification and minification filters when they differ.
+        return mip_filter != MipFilter::none || footprint != FootprintFilter::isotropic || mag_filter != min_filter;
+    }
     /// True when a lookup may read levels other than 0.
     bool uses_mip_levels() const;
 

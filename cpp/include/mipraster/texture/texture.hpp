@@ -1,6 +1,7 @@
 #pragma once
 // Textures: level 0 as given, mip levels and summed-area tables built lazily the first time a
 // lookup needs them, under a process-wide byte budget with least-recently-used eviction.
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -84,14 +85,23 @@ public:
     int height() const { return height_; }
     int level_count() const { return levels_; }
     /// Level k, 0 ≤ k < level_count() (else std::out_of_range); built (with the levels above it)
-    /// on first use.
-    const TextureLevel& level(int k) const;
+    /// on first use. Inline for built levels: lookups ask for a level or two each.
+    const TextureLevel& level(int k) const {
+        if (k == 0) return *base_;
+        if (k > 0 && k < levels_)
+            if (const TextureLevel* built = published_[k].load(std::memory_order_acquire)) return *built;
+        return build_level(k);
+    }
     /// The summed-area table and the level it was built on.
     const SummedAreaTable& summed_area_table() const;
     int summed_area_table_level() const;
 
 private:
+    const TextureLevel& build_level(int k) const;  // builds level k, or throws for a bad k
+
     detail::TextureData* data_;
+    const TextureLevel* base_;
+    const std::atomic<const TextureLevel*>* published_;  // the data's built levels (null: not yet)
     int width_, height_, levels_;
 };
 
