@@ -257,7 +257,7 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
 template <TexelFilter kFilter>
 Texel probe_mean(const AnisoProbes& p, double u, double v, const TextureLevel& level, const Sampler& s) {
     const double step = 1.0 / p.count;
-    if (kFilter == TexelFilter::linear) {
+    if constexpr (kFilter == TexelFilter::linear) {
         // Bilinear quads at x = u·w − ½ + o·du·w: when both end quads lie inside the level (so do
         // all between: rounding is monotonic), no probe wraps, and positions step along the line
         // with neither wrapping nor floor. Repeat and mirror first move the centre by whole
@@ -288,7 +288,8 @@ Texel probe_mean(const AnisoProbes& p, double u, double v, const TextureLevel& l
     const auto probe = [&](int k) {
         const double o = (k + 0.5) * step - 0.5;
         const double pu = u + o * p.du, pv = v + o * p.dv;
-        return kFilter == TexelFilter::linear ? bilinear(level, pu, pv, s) : nearest(level, pu, pv, s);
+        if constexpr (kFilter == TexelFilter::linear) return bilinear(level, pu, pv, s);
+        else return nearest(level, pu, pv, s);
     };
     const Texel first = probe(0);
     Texel difference = splat(0.0f);
