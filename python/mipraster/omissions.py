@@ -2,31 +2,31 @@
 
 For each omission of DESIGN.md §3 ("leave out what a scene does not need") a small scene where it
 applies is rendered two ways: as the pipeline renders it (the omission at work) and in a way that
-forces the work (what it would cost without), at one thread. Where nothing can force the work, the
-row says so and gives no number rather than an invented one.
+forces the work (what it would cost without), at one thread on one CPU. Where nothing can force
+the work, the row says so and gives no number rather than an invented one.
 
-Each variant runs in its own Python process (pinned to CPU 0 when ``taskset`` exists) so that its
-memory is its own: ``memory`` is the growth of the process's peak resident set during the timed
-frames over its peak after building the scene (``getrusage`` on Linux, which includes every
-allocation the renderer and the texture cache make). Time is the median of repeated frames after a
-warm-up frame; anything a frame needs that is not the omission (a fresh texture for the lazy-mip
-row) is built outside the timed part. Where the two variants should draw the same image, the
-images are compared: ``exact`` (bit-identical) or ``close`` (within ``CLOSE_TOLERANCE``, where
-one variant computes the same value by another route, e.g. 1/w = 1 divided out).
+Time is the median of repeated frames, the two variants alternating frame by frame (so both see
+the same background load) after a warm-up frame of each; anything a frame needs that is not the
+omission (a fresh texture for the lazy-mip row) is built outside the timed part. Memory is the
+growth of the resident set during one frame over the resident set before it (Linux: the peak is
+reset through /proc/self/clear_refs, and freed heap memory returned with malloc_trim first). It
+counts everything the frame allocates: the Python layer's copy of the meshes, the output image,
+tile buffers, kept samples, texture levels. Where the two variants should draw the same image,
+the images are compared: ``exact`` (bit-identical) or ``close`` (within ``CLOSE_TOLERANCE``,
+where one variant computes the same value by another route, e.g. 1/w = 1 divided out).
 """
 from __future__ import annotations
 
+import contextlib
+import ctypes
+import gc
 import json
 import os
-import resource
-import shutil
 import statistics
-import subprocess
 import sys
-import tempfile
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any, Callable, Dict, List, Optional
+from typing import Any, Callable, Dict, Iterator, List, Optional
 
 import numpy as np
 
@@ -227,24 +227,60 @@ def render_variant(variant: Variant, width: int, height: int, state: Optional[Di
     return mr.render(state["scene"], state["camera"], width, height, threads=1, depth=False, **options)
 
 
-def _peak_rss_bytes() -> int:
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # kilobytes on Linux
+def _status_bytes(key: str) -> int:
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith(key + ":"):
+                return int(line.split()[1]) * 1024  # kB
+    raise KeyError(key)
 
 
-def measure_variant(variant: Variant, width: int, height: int, frames: int) -> Dict[str, Any]:
-    """Median ms of `frames` frames after a warm-up, and the peak-RSS growth over the setup's."""
-    state = variant.setup(width, height)
-    before = _peak_rss_bytes()
-    image = render_variant(variant, width, height, state).color
-    times = []
-    for _ in range(frames):
-        state.clear()  # drop the last frame's state before building the next one
+def render_memory(variant: Variant, width: int, height: int) -> Optional[int]:
+    """Growth of the resident set during one frame (its peak over the resident set before it), or
+    None where Linux's /proc and glibc's malloc_trim are not available. Freed heap memory is first
+    returned to the system, so the frame cannot hide its allocations in memory freed before it."""
+    try:
+        libc = ctypes.CDLL("libc.so.6")
         state = variant.setup(width, height)
-        t0 = time.perf_counter()
+        gc.collect()
+        libc.malloc_trim(0)
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")  # resets VmHWM, the peak resident set, to the current one
+        before = _status_bytes("VmRSS")
         render_variant(variant, width, height, state)
-        times.append(time.perf_counter() - t0)
-    return {"median_ms": statistics.median(times) * 1e3, "times_ms": [t * 1e3 for t in times],
-            "memory": _peak_rss_bytes() - before, "image": image}
+        return _status_bytes("VmHWM") - before
+    except (OSError, KeyError, AttributeError):
+        return None
+
+
+@contextlib.contextmanager
+def pinned_to_one_cpu() -> Iterator[None]:
+    """Runs the block on one CPU (the first this process may use) where the OS allows it."""
+    if not hasattr(os, "sched_setaffinity"):
+        yield
+        return
+    allowed = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, {min(allowed)})
+    try:
+        yield
+    finally:
+        os.sched_setaffinity(0, allowed)
+
+
+def time_pair(a: Variant, b: Variant, width: int, height: int, frames: int) -> tuple:
+    """Frame times in ms of a and b, alternating frame by frame after a warm-up frame of each, so
+    that both see the same background load; each frame's state is built untimed. Also returns
+    the last image of each."""
+    times: Dict[int, List[float]] = {0: [], 1: []}
+    images = [render_variant(v, width, height).color for v in (a, b)]  # warm-up
+    for _ in range(frames):
+        for i, v in enumerate((a, b)):
+            state = v.setup(width, height)
+            t0 = time.perf_counter()
+            render_variant(v, width, height, state)
+            times[i].append((time.perf_counter() - t0) * 1e3)
+            del state
+    return times[0], times[1], images
 
 
 def compare_images(kind: str, a: np.ndarray, b: np.ndarray) -> str:
@@ -257,41 +293,20 @@ def compare_images(kind: str, a: np.ndarray, b: np.ndarray) -> str:
     return "identical" if diff == 0.0 else f"max |diff| {diff:.2g}"
 
 
-def _child(index: int, which: str, width: int, height: int, frames: int, image_path: str) -> None:
-    row = OMISSIONS[index]
-    result = measure_variant(row.with_it if which == "with" else row.without, width, height, frames)
-    np.save(image_path, result.pop("image"))
-    print(json.dumps(result))
-
-
-def _run_child(index: int, which: str, width: int, height: int, frames: int, tmp: str) -> Dict[str, Any]:
-    image_path = os.path.join(tmp, f"{index}_{which}.npy")
-    cmd = [sys.executable, "-m", "mipraster.omissions", "--child", str(index), which, str(width), str(height),
-           str(frames), image_path]
-    if shutil.which("taskset"):
-        cmd = ["taskset", "-c", "0"] + cmd
-    done = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if done.returncode != 0:
-        raise RuntimeError(f"omission {OMISSIONS[index].name!r} ({which}) failed:\n{done.stderr[-2000:]}")
-    result = json.loads(done.stdout.strip().splitlines()[-1])
-    result["image"] = np.load(image_path)
-    return result
-
-
 def measure(width: int, height: int, frames: int) -> List[Row]:
-    """Every row of OMISSIONS, each variant in its own process."""
+    """Every row of OMISSIONS at one thread, pinned to one CPU."""
     rows = []
-    with tempfile.TemporaryDirectory() as tmp:
-        for i, om in enumerate(OMISSIONS):
+    with pinned_to_one_cpu():
+        for om in OMISSIONS:
             row = Row(om.name, om.scene, om.with_it.label, om.without.label if om.without else "–", note=om.note)
             if om.without is not None:
-                a = _run_child(i, "with", width, height, frames, tmp)
-                b = _run_child(i, "without", width, height, frames, tmp)
-                row.with_ms, row.without_ms = a["median_ms"], b["median_ms"]
-                row.with_memory, row.without_memory = a["memory"], b["memory"]
-                row.samples = {"with_ms": a["times_ms"], "without_ms": b["times_ms"]}
+                a, b, images = time_pair(om.with_it, om.without, width, height, frames)
+                row.with_ms, row.without_ms = statistics.median(a), statistics.median(b)
+                row.samples = {"with_ms": a, "without_ms": b}
+                row.with_memory = render_memory(om.with_it, width, height)
+                row.without_memory = render_memory(om.without, width, height)
                 if om.same_image:
-                    row.image_check = compare_images(om.same_image, a["image"], b["image"])
+                    row.image_check = compare_images(om.same_image, *images)
             print(f"omission {row.name}: {row.with_ms} / {row.without_ms} ms", file=sys.stderr)
             rows.append(row)
     return rows
@@ -301,7 +316,7 @@ def markdown(rows: List[Row], width: int, height: int) -> str:
     """The omission table."""
     mib = lambda v: "–" if v is None else f"{v / 2**20:,.1f}"  # noqa: E731
     ms = lambda v: "–" if v is None else f"{v:,.2f}"  # noqa: E731
-    lines = [f"Omissions at {width}×{height}, 1 thread (median ms; memory = peak-RSS growth while rendering, MiB):",
+    lines = [f"Omissions at {width}×{height}, 1 thread (median ms; memory = resident-set growth during a frame, MiB):",
              "", "| omission | scene | with it | ms | MiB | without (forced work) | ms | MiB | saves | same image |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -324,11 +339,3 @@ def run(out_dir: str, quick: bool = False) -> List[Row]:
     with open(os.path.join(out_dir, "omissions.json"), "w") as f:
         json.dump({"width": width, "height": height, "rows": [asdict(r) for r in rows]}, f, indent=1)
     return rows
-
-
-if __name__ == "__main__":
-    if len(sys.argv) == 8 and sys.argv[1] == "--child":
-        _child(int(sys.argv[2]), sys.argv[3], int(sys.argv[4]), int(sys.argv[5]), int(sys.argv[6]), sys.argv[7])
-    else:
-        sys.exit("usage: python -m mipraster.omissions --child INDEX with|without WIDTH HEIGHT FRAMES IMAGE.npy "
-                 "(internal; run `python -m mipraster.bench --omissions`)")

@@ -17,6 +17,7 @@ def test_fit_recovers_a_linear_law():
     assert f["a"] == pytest.approx(2.0, rel=1e-9) and f["b"] == pytest.approx(3e-6, rel=1e-9)
     assert abs(f["c2"]) < 1e-15 and abs(f["superlinear_share"]) < 1e-9
     assert f["exponent"] == pytest.approx(1.0, abs=1e-5)
+    assert f["marginal"] == pytest.approx([3e-6] * 4, rel=1e-9)  # a linear law's marginal cost is b
 
 
 def test_fit_recovers_an_n_log_n_term():
@@ -31,6 +32,11 @@ def test_fit_recovers_an_n_log_n_term():
 @pytest.mark.parametrize("a", [0.0, 3.0])
 def test_fit_recovers_a_power_law_exponent(p, a):
     assert growth.fit(N, a + 4e-4 * N ** p)["exponent"] == pytest.approx(p, abs=1e-5)
+
+
+def test_marginal_costs_grow_for_a_quadratic_law():
+    f = growth.fit([1, 2, 4, 8], [1, 4, 16, 64])  # marginal 3, 6, 12: each step twice the last
+    assert f["marginal"] == pytest.approx([3, 6, 12])
 
 
 def test_fit_needs_three_points():

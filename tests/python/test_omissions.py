@@ -70,3 +70,13 @@ def test_bench_omissions_end_to_end(tmp_path, monkeypatch):
         assert (r["image_check"] != "") == bool(o.same_image)
     table = (tmp_path / "omissions.md").read_text()
     assert "| specialization vs a generic path | any |" in table and "not measured" in table
+
+
+def test_memory_sees_the_kept_sample_buffer():
+    om = next(o for o in omissions.OMISSIONS if o.name == "no resolve at 1 sample")
+    w, h = 320, 180
+    with_it, without = (omissions.render_memory(v, w, h) for v in (om.with_it, om.without))
+    if with_it is None:
+        pytest.skip("no /proc/self/clear_refs or malloc_trim here")
+    # The image itself (RGBA float) is in both; keeping the samples adds at least their colour.
+    assert with_it >= w * h * 16 and without - with_it >= w * h * 16
