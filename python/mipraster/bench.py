@@ -33,6 +33,7 @@ Where the scenes are found: ``--bench-dir``, else ``$MIPRASTER_BENCH_DIR``, else
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib.util
 import json
 import math
@@ -42,7 +43,7 @@ import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Dict, Iterator, List, Optional, Sequence
 
 import numpy as np
 
@@ -137,6 +138,20 @@ def time_frames(frame, min_frames: int, min_time: float, max_frames: int) -> Lis
         if enough or (len(times) >= 3 and statistics.median(times) > SLOW_FRAME_S):
             break
     return times
+
+
+@contextlib.contextmanager
+def pinned_to_one_cpu() -> Iterator[None]:
+    """Runs the block on one CPU (the first this process may use) where the OS allows it."""
+    if not hasattr(os, "sched_setaffinity"):
+        yield
+        return
+    allowed = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, {min(allowed)})
+    try:
+        yield
+    finally:
+        os.sched_setaffinity(0, allowed)
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:

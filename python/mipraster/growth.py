@@ -11,9 +11,10 @@ Triangle counts 10³ … 10⁷ at ``TRIANGLE_SIZE`` and one sample; then the gri
 ``SAMPLE_SWEEP_TRIANGLES`` triangles over resolutions × SSAA sample counts. Each point is the
 median of repeated frames (``bench.time_frames``) at one thread. Each series is fitted
 (relative least squares) with ``t = a + b·x``, with ``t = a + b·x + c·x·log2 x`` (the superlinear
-term's share of the largest point says whether it matters), and with ``t = a + k·x^p`` (the
-exponent p; 1 is linear). A point the memory limit refuses is recorded
-as skipped, never estimated.
+term's share of the largest point), and with ``t = a + k·x^p`` (the exponent p; 1 is linear);
+the marginal cost of each step between sizes shows a superlinear term directly (it would rise).
+The study runs on one CPU (``bench.pinned_to_one_cpu``). A point the memory limit refuses is
+recorded as skipped, never estimated.
 """
 from __future__ import annotations
 
@@ -222,25 +223,32 @@ def plot(points: Sequence[Point], fits: Dict[str, Dict[str, float]], path: str) 
     Image.open(path).convert("RGB").quantize(colors=32).save(path, optimize=True)
 
 
-def run(out_dir: str, quick: bool = False) -> Dict[str, object]:
-    """Both sweeps: prints and writes growth.md, growth.json and cost_growth.png to out_dir."""
-    counts = QUICK_TRIANGLE_COUNTS if quick else TRIANGLE_COUNTS
-    widths = QUICK_SAMPLE_SWEEP_WIDTHS if quick else SAMPLE_SWEEP_WIDTHS
-    spps = QUICK_SAMPLE_SWEEP_SPP if quick else SAMPLE_SWEEP_SPP
-    frames = (3, 0.2, 5) if quick else (3, 1.0, 9)
+def sweep(counts: Sequence[int], widths: Sequence[int], spps: Sequence[int], frames: tuple) -> List[Point]:
+    """The timed points of both sweeps, on one CPU."""
+    from .bench import pinned_to_one_cpu
+
     w, h = TRIANGLE_SIZE
     points: List[Point] = []
-    for kind in ("grid", "random"):
-        for n in counts:
-            points.append(time_point(f"triangles:{kind}", kind, n, w, h, 1, n, *frames))
-            print(f"growth {points[-1]}", file=sys.stderr)
-    for spp in spps:
-        for width in widths:
-            height = width * 9 // 16
-            p = time_point(f"samples:grid {spp} spp", "grid", SAMPLE_SWEEP_TRIANGLES, width, height, spp,
-                           width * height * spp, *frames)
-            points.append(p)
-            print(f"growth {p}", file=sys.stderr)
+    with pinned_to_one_cpu():
+        for kind in ("grid", "random"):
+            for n in counts:
+                points.append(time_point(f"triangles:{kind}", kind, n, w, h, 1, n, *frames))
+                print(f"growth {points[-1]}", file=sys.stderr)
+        for spp in spps:
+            for width in widths:
+                height = width * 9 // 16
+                points.append(time_point(f"samples:grid {spp} spp", "grid", SAMPLE_SWEEP_TRIANGLES, width, height,
+                                         spp, width * height * spp, *frames))
+                print(f"growth {points[-1]}", file=sys.stderr)
+    return points
+
+
+def run(out_dir: str, quick: bool = False) -> Dict[str, object]:
+    """Both sweeps: prints and writes growth.md, growth.json and cost_growth.png to out_dir."""
+    points = sweep(QUICK_TRIANGLE_COUNTS if quick else TRIANGLE_COUNTS,
+                   QUICK_SAMPLE_SWEEP_WIDTHS if quick else SAMPLE_SWEEP_WIDTHS,
+                   QUICK_SAMPLE_SWEEP_SPP if quick else SAMPLE_SWEEP_SPP,
+                   (3, 0.2, 5) if quick else (3, 1.0, 9))
     # One series over every resolution and sample count together: time against W·H·S.
     points += [Point("samples:grid all", p.x, p.width, p.height, p.spp, p.triangles, p.median_ms, p.frames, p.note)
                for p in list(points) if p.series.startswith("samples:grid ")]

@@ -17,7 +17,6 @@ where one variant computes the same value by another route, e.g. 1/w = 1 divided
 """
 from __future__ import annotations
 
-import contextlib
 import ctypes
 import gc
 import json
@@ -26,9 +25,11 @@ import statistics
 import sys
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any, Callable, Dict, Iterator, List, Optional
+from typing import Any, Callable, Dict, List, Optional
 
 import numpy as np
+
+from .bench import pinned_to_one_cpu
 
 SIZE = (1280, 720)
 QUICK_SIZE = (160, 90)
@@ -253,20 +254,6 @@ def render_memory(variant: Variant, width: int, height: int) -> Optional[int]:
         return _status_bytes("VmHWM") - before
     except (OSError, KeyError, AttributeError):
         return None
-
-
-@contextlib.contextmanager
-def pinned_to_one_cpu() -> Iterator[None]:
-    """Runs the block on one CPU (the first this process may use) where the OS allows it."""
-    if not hasattr(os, "sched_setaffinity"):
-        yield
-        return
-    allowed = os.sched_getaffinity(0)
-    os.sched_setaffinity(0, {min(allowed)})
-    try:
-        yield
-    finally:
-        os.sched_setaffinity(0, allowed)
 
 
 def time_pair(a: Variant, b: Variant, width: int, height: int, frames: int) -> tuple:
