@@ -11,7 +11,13 @@ per frame of each renderer, their ratio, and the PSNR between the two images; wr
 Usage::
 
     python -m mipraster.bench [--scenes plane cube ...] [--modes 1x msaa4 ssaa4] [--threads 1 2]
-                              [--no-anchor] [--quick] [--out DIR] [--bench-dir DIR]
+                              [--no-anchor] [--quick] [--out DIR] [--bench-dir DIR] [--roofline [PATH]]
+    python -m mipraster.bench --growth [--quick] [--out DIR]       # cost growth (growth.py)
+    python -m mipraster.bench --omissions [--quick] [--out DIR]    # what omissions save (omissions.py)
+
+``--roofline`` adds each case's roofline (roofline.py): the least time its framebuffer writes and
+texture lookups need at the machine's measured limits, and the fraction of it the frame reaches.
+``--growth`` and ``--omissions`` run their study instead of the scene matrix.
 
 A frame is what llvmpipe's is: clear, draw, resolve, and the image in a numpy array (mipraster
 renders straight into one). Scene construction (meshes, textures) is outside the timed frame, as
@@ -27,6 +33,7 @@ Where the scenes are found: ``--bench-dir``, else ``$MIPRASTER_BENCH_DIR``, else
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib.util
 import json
 import math
@@ -36,9 +43,11 @@ import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Dict, Iterator, List, Optional, Sequence
 
 import numpy as np
+
+from . import roofline
 
 MODES = {"1x": (1, "ssaa"), "msaa4": (4, "msaa"), "ssaa4": (4, "ssaa")}  # name -> (spp, aa)
 SLOW_FRAME_S = 2.0  # frames slower than this: 3 timed frames are enough
@@ -60,6 +69,13 @@ class Case:
     llvmpipe_ms: Optional[float] = None
     ratio: Optional[float] = None  # mipraster / llvmpipe: below 1 is faster
     psnr_db: Optional[float] = None  # mipraster's 8-bit image against llvmpipe's
+    # --roofline (see roofline.py): the frame's work, its lower bound and the fraction reached
+    bytes_written: Optional[int] = None
+    lookups: Optional[int] = None
+    write_ms: Optional[float] = None   # bytes_written at the measured write bandwidth
+    lookup_ms: Optional[float] = None  # lookups at the measured trilinear rate
+    bound_ms: Optional[float] = None   # the larger of the two
+    roofline_fraction: Optional[float] = None  # bound / median: 1 would be at the machine's limit
 
 
 def find_bench_dir(explicit: Optional[str] = None) -> str:
@@ -122,6 +138,20 @@ def time_frames(frame, min_frames: int, min_time: float, max_frames: int) -> Lis
         if enough or (len(times) >= 3 and statistics.median(times) > SLOW_FRAME_S):
             break
     return times
+
+
+@contextlib.contextmanager
+def pinned_to_one_cpu() -> Iterator[None]:
+    """Runs the block on one CPU (the first this process may use) where the OS allows it."""
+    if not hasattr(os, "sched_setaffinity"):
+        yield
+        return
+    allowed = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, {min(allowed)})
+    try:
+        yield
+    finally:
+        os.sched_setaffinity(0, allowed)
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:
@@ -199,6 +229,25 @@ def thread_scaling(cases: Sequence[Case]) -> Dict[str, float]:
             for (s, m, t) in by_key if t == 1 and (s, m, 2) in by_key}
 
 
+def add_roofline(case: Case, limits: roofline.MachineLimits, spp: int, bench_scene: Any,
+                 stats: Dict[str, Any]) -> None:
+    """Fills the case's roofline fields from the frame's render statistics."""
+    work = roofline.frame_work(case.width, case.height, spp, bool(bench_scene.depth_test),
+                               int(stats["samples_passed"]), int(stats["shader_invocations"]),
+                               bench_scene.texture is not None)
+    bound = roofline.bound_seconds(work, *limits.for_threads(case.threads))
+    case.bytes_written, case.lookups = work.bytes_written, work.lookups
+    case.write_ms, case.lookup_ms, case.bound_ms = (bound[k] * 1e3 for k in ("write_s", "lookup_s", "bound_s"))
+    case.roofline_fraction = case.bound_ms / case.median_ms
+
+
+def roofline_row(case: Case) -> Dict[str, Any]:
+    """A row of roofline.markdown for a case that has its roofline."""
+    return {"scene": case.scene, "mode": case.mode, "threads": case.threads, "bytes_written": case.bytes_written,
+            "lookups": case.lookups, "write_s": case.write_ms / 1e3, "lookup_s": case.lookup_ms / 1e3,
+            "measured_ms": case.median_ms, "fraction": case.roofline_fraction}
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m mipraster.bench", description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -212,12 +261,31 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--no-anchor", action="store_true", help="do not run llvmpipe")
     ap.add_argument("--bench-dir", help="folder with scenes.py and anchor_llvmpipe.py")
     ap.add_argument("--out", default="bench_results", help="output folder [bench_results]")
+    ap.add_argument("--roofline", nargs="?", const="", metavar="PATH",
+                    help="add each case's roofline; PATH: the mipraster_bench_roofline executable or a JSON "
+                         "it wrote (default: $MIPRASTER_BENCH_ROOFLINE, PATH, next to the mipraster command)")
+    ap.add_argument("--growth", action="store_true", help="run the cost-growth study instead (growth.py)")
+    ap.add_argument("--omissions", action="store_true", help="run the omission table instead (omissions.py)")
     args = ap.parse_args(argv)
     for t in args.threads:
         if t < 1:
             ap.error(f"--threads: {t} is not a thread count (>= 1)")
+    for name in ("min_frames", "max_frames"):
+        if getattr(args, name) < 1:
+            ap.error(f"--{name.replace('_', '-')}: {getattr(args, name)} is not a frame count (>= 1)")
+    if not (args.min_time >= 0 and math.isfinite(args.min_time)):
+        ap.error(f"--min-time: {args.min_time} is not a finite number of seconds (>= 0)")
     if args.quick:
         args.min_frames, args.min_time, args.max_frames = 3, 0.2, 5
+    if args.growth or args.omissions:
+        from . import growth, omissions
+
+        os.makedirs(args.out, exist_ok=True)
+        if args.growth:
+            growth.run(args.out, quick=args.quick)
+        if args.omissions:
+            omissions.run(args.out, quick=args.quick)
+        return 0
 
     import mipraster as mr
 
@@ -229,6 +297,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         ap.error(f"--scenes: unknown {unknown}; scenes.py has {scenes_module.SCENE_NAMES}")
     os.makedirs(args.out, exist_ok=True)
 
+    limits = None
+    if args.roofline is not None:
+        try:
+            limits = roofline.measure_limits(args.roofline or None, args.out, args.quick)
+        except (FileNotFoundError, RuntimeError) as e:
+            ap.error(str(e))
     cases: List[Case] = []
     images: Dict[tuple, np.ndarray] = {}
     for name in names:
@@ -241,12 +315,15 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 result: Dict[str, Any] = {}
 
                 def frame() -> None:
-                    result["image"] = mr.render(scene, camera, w, h, spp=spp, aa=aa, threads=threads,
-                                                clear_color=bench_scene.clear_color, depth=False).color
+                    rendered = mr.render(scene, camera, w, h, spp=spp, aa=aa, threads=threads,
+                                         clear_color=bench_scene.clear_color, depth=False)
+                    result["image"], result["stats"] = rendered.color, rendered.stats
 
                 times = time_frames(frame, args.min_frames, args.min_time, args.max_frames)
                 case = Case(name, mode, threads, w, h, bench_scene.n_triangles, statistics.median(times) * 1e3,
                             min(times) * 1e3, len(times))
+                if limits is not None:
+                    add_roofline(case, limits, spp, bench_scene, result["stats"])
                 cases.append(case)
                 images[(name, mode)] = to_rgb8_linear(result["image"])
                 print(f"mipraster {name:18s} {mode:6s} {threads}T {case.median_ms:10.2f} ms "
@@ -272,12 +349,15 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 c.psnr_db = psnr(images[(c.scene, c.mode)], other)
 
     table = markdown(cases, note)
+    if limits is not None:
+        table += "\n" + roofline.markdown([roofline_row(c) for c in cases], limits)
     print(table)
     with open(os.path.join(args.out, "bench.md"), "w") as f:
         f.write(table)
     with open(os.path.join(args.out, "bench.json"), "w") as f:
         json.dump({"bench_dir": bench_dir, "cases": [asdict(c) for c in cases],
-                   "thread_scaling": thread_scaling(cases), "anchor": note}, f, indent=1,
+                   "thread_scaling": thread_scaling(cases), "anchor": note,
+                   "roofline_limits": None if limits is None else asdict(limits)}, f, indent=1,
                   default=lambda v: None)
     return 0
 

@@ -2,6 +2,7 @@
 report, run end to end on a small stand-in for the shared scenes.py (timings are never asserted)."""
 import json
 import math
+import os
 import subprocess
 import sys
 import textwrap
@@ -143,3 +144,11 @@ def test_bad_arguments_are_named(bench_dir, tmp_path, argv, message):
 def test_missing_bench_dir_is_named(tmp_path):
     with pytest.raises(FileNotFoundError, match="no scenes.py"):
         bench.find_bench_dir(str(tmp_path / "absent"))
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_setaffinity"), reason="no CPU affinity on this OS")
+def test_pinned_to_one_cpu_restores_the_affinity():
+    before = os.sched_getaffinity(0)
+    with bench.pinned_to_one_cpu():
+        assert os.sched_getaffinity(0) == {min(before)}
+    assert os.sched_getaffinity(0) == before

@@ -1,0 +1,336 @@
+"""What leaving out unneeded work saves: each omission's time and memory with and without it.
+
+For each omission of DESIGN.md §3 ("leave out what a scene does not need") a small scene where it
+applies is rendered two ways: as the pipeline renders it (the omission at work) and in a way that
+forces the work (what it would cost without), at one thread on one CPU. Where nothing can force
+the work, the row says so and gives no number rather than an invented one.
+
+Time is the median of repeated frames, the two variants alternating frame by frame (so both see
+the same background load) after a warm-up frame of each; anything a frame needs that is not the
+omission (a fresh texture for the lazy-mip row) is built outside the timed part. Memory is the
+growth of the resident set during one frame over the resident set before it (Linux: the peak is
+reset through /proc/self/clear_refs, and freed heap memory returned with malloc_trim first). It
+counts everything the frame allocates: the Python layer's copy of the meshes, the output image,
+tile buffers, kept samples, texture levels. Where the two variants should draw the same image,
+the images are compared: ``exact`` (bit-identical) or ``close`` (within ``CLOSE_TOLERANCE``,
+where one variant computes the same value by another route, e.g. 1/w = 1 divided out).
+"""
+from __future__ import annotations
+
+import ctypes
+import gc
+import json
+import os
+import statistics
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Any, Callable, Dict, List, Optional
+
+import numpy as np
+
+from .bench import pinned_to_one_cpu
+
+SIZE = (1280, 720)
+QUICK_SIZE = (160, 90)
+GRID_TRIANGLES = 20_000  # about: growth.grid_mesh rounds to whole rows and columns
+OFFSCREEN_TRIANGLES = 200_000
+CLOSE_TOLERANCE = 1e-5  # largest |difference| of a linear colour value for 'close'
+
+
+@dataclass
+class Variant:
+    """One way of rendering a row's scene: ``setup()`` (untimed) returns the render's arguments;
+    ``force(state)`` (timed, optional) does extra work before the render."""
+
+    label: str
+    setup: Callable[[int, int], Dict[str, Any]]
+    force: Optional[Callable[[Dict[str, Any]], None]] = None
+
+
+@dataclass
+class Omission:
+    """A row of the table: the omission, where it applies, and its two variants (None: the work
+    cannot be forced)."""
+
+    name: str
+    scene: str
+    with_it: Variant
+    without: Optional[Variant]
+    same_image: str  # "exact", "close" or "" (not compared)
+    note: str = ""
+    forced: bool = True  # False: `without` is a comparison, not the omitted work forced back in
+
+
+@dataclass
+class Row:
+    """A measured row."""
+
+    name: str
+    scene: str
+    with_label: str
+    without_label: str
+    with_ms: Optional[float] = None
+    without_ms: Optional[float] = None
+    with_memory: Optional[int] = None  # bytes
+    without_memory: Optional[int] = None
+    image_check: str = ""  # "identical", "max |diff| 3e-08", or "" when not compared
+    note: str = ""
+    forced: bool = True
+    samples: Dict[str, List[float]] = field(default_factory=dict)
+
+
+# ---- scenes --------------------------------------------------------------------------------------
+
+def _ndc_camera() -> Any:
+    import mipraster as mr
+
+    return mr.Camera.from_matrices(np.eye(4), np.eye(4), depth_convention="opengl")
+
+
+def _grid(width: int, height: int, n: int = GRID_TRIANGLES) -> tuple:
+    from .growth import grid_mesh
+
+    return grid_mesh(n, width / height)
+
+
+def _white_texture() -> Any:
+    import mipraster as mr
+
+    return mr.Texture(np.full((1, 1, 4), 255, np.uint8), srgb=False, name="white 1x1")
+
+
+def colour_grid(textured_with: Optional[str] = None, depth_test: bool = True, colors: str = "vertex",
+                offscreen: int = 0) -> Callable[[int, int], Dict[str, Any]]:
+    """Setup of the vertex-coloured NDC grid: optionally with uvs and a 1×1 white texture read
+    through the named filter (texture × colour = colour), without depth test, with constant colour
+    as vertex colours (``colors='white-vertex'``) or none (``'none'``: the draw colour), and with
+    `offscreen` extra triangles to the right of the screen (x in NDC 3…5)."""
+    def setup(width: int, height: int) -> Dict[str, Any]:
+        import mipraster as mr
+
+        positions, tris, vertex_colors = _grid(width, height)
+        scene = mr.Scene()
+        kwargs: Dict[str, Any] = {"depth_test": depth_test}
+        if colors == "none":
+            vertex_colors, kwargs["color"] = None, (0.8, 0.6, 0.4, 1.0)
+        elif colors == "white-vertex":
+            vertex_colors = np.tile(np.float32([0.8, 0.6, 0.4, 1.0]), (len(positions), 1))
+        uvs = positions[:, :2] * 0.5 + 0.5 if textured_with else None
+        if textured_with:
+            kwargs["texture"], kwargs["sampler"] = _white_texture(), mr.Sampler(filter=textured_with)
+        scene.add(mr.Mesh(positions, tris, colors=vertex_colors, uvs=uvs), **kwargs)
+        if offscreen:
+            p, t, c = _grid(width, height, offscreen)
+            p = p.copy()
+            p[:, 0] += 4.0
+            scene.add(mr.Mesh(p, t, colors=c), depth_test=depth_test)
+        return {"scene": scene, "camera": _ndc_camera()}
+    return setup
+
+
+def _checker(size: int) -> np.ndarray:
+    tex = np.full((size, size, 4), 255, np.uint8)
+    cells = (np.arange(size) // 16)
+    tex[((cells[:, None] + cells[None, :]) % 2) == 1, :3] = (40, 90, 200)
+    return tex
+
+
+def ortho_textured(interpolation: str) -> Callable[[int, int], Dict[str, Any]]:
+    """Setup of a textured, vertex-coloured grid seen by an orthographic camera, uvs and colours
+    interpolated with `interpolation`."""
+    def setup(width: int, height: int) -> Dict[str, Any]:
+        import mipraster as mr
+
+        positions, tris, colors = _grid(width, height)
+        positions = positions * np.float32([width / height, 1.0, 1.0])
+        uvs = positions[:, :2] * 0.5 + 0.5
+        scene = mr.Scene()
+        scene.add(mr.Mesh(positions, tris, colors=colors, uvs=uvs), interpolation=interpolation,
+                  texture=mr.Texture(_checker(256), srgb=False, name="checker"), sampler="trilinear")
+        return {"scene": scene, "camera": mr.Camera.orthographic((0, 0, 1), (0, 0, 0), height=2.0, near=0.5, far=2.0)}
+    return setup
+
+
+def magnified_quad(width: int, height: int) -> Dict[str, Any]:
+    """A full-screen quad showing a quarter of a fresh 1024² checker (magnified: level 0 only)."""
+    import mipraster as mr
+
+    positions = np.float32([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]])
+    uvs = np.float32([[0, 0.5], [0.5, 0.5], [0.5, 0], [0, 0]])
+    texture = mr.Texture(_checker(1024), srgb=False, name="checker 1024")
+    scene = mr.Scene()
+    scene.add(mr.Mesh(positions, np.array([[0, 1, 2], [0, 2, 3]]), uvs=uvs), texture=texture, sampler="trilinear")
+    return {"scene": scene, "camera": _ndc_camera(), "texture": texture}
+
+
+def build_all_levels(state: Dict[str, Any]) -> None:
+    """Builds every mip level of the state's texture (level k builds the levels above it too)."""
+    texture = state["texture"]
+    texture.level(texture.level_count - 1)
+
+
+def with_options(setup: Callable[[int, int], Dict[str, Any]], **options: Any) -> Callable[[int, int], Dict[str, Any]]:
+    """`setup` with extra mr.render options."""
+    def wrapped(width: int, height: int) -> Dict[str, Any]:
+        return {**setup(width, height), **options}
+    return wrapped
+
+
+OMISSIONS = [
+    Omission("no derivatives for untextured draws", f"{GRID_TRIANGLES:,}-triangle colour grid",
+             Variant("untextured", colour_grid()),
+             Variant("1×1 white texture, trilinear (uv, derivatives, λ, lookup)", colour_grid("trilinear")),
+             "exact"),
+    Omission("no derivatives when λ does not matter", "the same grid with a 1×1 white texture",
+             Variant("bilinear (no derivatives)", colour_grid("bilinear")),
+             Variant("trilinear (derivatives and λ)", colour_grid("trilinear")), "exact"),
+    Omission("no perspective division for orthographic cameras", "textured colour grid, orthographic camera",
+             Variant("interpolation='screen' (by hand)", ortho_textured("screen")),
+             Variant("interpolation='perspective' (the default)", ortho_textured("perspective")), "close",
+             "not automatic: the kernel follows the draw's interpolation, not the camera; with w = 1 both give "
+             "the same values"),
+    Omission("no resolve at 1 sample", "colour grid, 1 sample",
+             Variant("tile writes straight into the image", colour_grid()),
+             Variant("keep_samples: whole-frame sample buffer + resolve pass (+ samples returned)",
+                     with_options(colour_grid(), keep_samples=True)), "exact"),
+    Omission("no depth buffer when nothing tests depth", "colour grid (no overlaps)",
+             Variant("depth_test=False", colour_grid(depth_test=False)),
+             Variant("depth_test=True (never rejects)", colour_grid()), "exact",
+             "the depth buffer is tile-local (one per worker), so the memory it saves is small"),
+    Omission("lazily built mip levels", "full-screen quad magnifying a fresh 1024² texture",
+             Variant("lazy: level 0 only", magnified_quad),
+             Variant("every level built first (timed)", magnified_quad, build_all_levels), "exact"),
+    Omission("culled off-screen triangles", f"colour grid + ~{OFFSCREEN_TRIANGLES:,} triangles off screen",
+             Variant(f"~{OFFSCREEN_TRIANGLES:,} off-screen triangles, culled",
+                     colour_grid(offscreen=OFFSCREEN_TRIANGLES)),
+             Variant("them removed from the input (comparison)", colour_grid()), "exact",
+             "no switch turns culling off: the comparison is the same frame without the off-screen triangles, "
+             "so the difference is what rejecting them costs, not what culling saves", forced=False),
+    Omission("specialization: constant colour", "colour grid with one colour",
+             Variant("no vertex colours (constant-colour kernel)", colour_grid(colors="none")),
+             Variant("the colour as vertex colours (interpolating kernel)", colour_grid(colors="white-vertex")),
+             "close"),
+    Omission("specialization vs a generic path", "any", Variant("specialized kernels", colour_grid()), None, "",
+             "not measured: there is no generic (unspecialized) kernel; every draw runs an instance "
+             "specialized on depth, blend, shading, samples and texturing (the rows above measure single features)"),
+]
+
+
+# ---- measuring ----------------------------------------------------------------------------------
+
+def render_variant(variant: Variant, width: int, height: int, state: Optional[Dict[str, Any]] = None) -> Any:
+    """One frame of `variant` (its forced work included); returns the RenderResult."""
+    import mipraster as mr
+
+    state = variant.setup(width, height) if state is None else state
+    if variant.force is not None:
+        variant.force(state)
+    options = {k: v for k, v in state.items() if k not in ("scene", "camera", "texture")}
+    return mr.render(state["scene"], state["camera"], width, height, threads=1, depth=False, **options)
+
+
+def _status_bytes(key: str) -> int:
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith(key + ":"):
+                return int(line.split()[1]) * 1024  # kB
+    raise KeyError(key)
+
+
+def render_memory(variant: Variant, width: int, height: int) -> Optional[int]:
+    """Growth of the resident set during one frame (its peak over the resident set before it), or
+    None where Linux's /proc and glibc's malloc_trim are not available. Freed heap memory is first
+    returned to the system, so the frame cannot hide its allocations in memory freed before it."""
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+        state = variant.setup(width, height)
+        gc.collect()
+        libc.malloc_trim(0)
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")  # resets VmHWM, the peak resident set, to the current one
+        before = _status_bytes("VmRSS")
+        render_variant(variant, width, height, state)
+        return _status_bytes("VmHWM") - before
+    except (OSError, KeyError, AttributeError):
+        return None
+
+
+def time_pair(a: Variant, b: Variant, width: int, height: int, frames: int) -> tuple:
+    """Frame times in ms of a and b, alternating frame by frame after a warm-up frame of each, so
+    that both see the same background load; each frame's state is built untimed. Also returns
+    the last image of each."""
+    times: Dict[int, List[float]] = {0: [], 1: []}
+    images = [render_variant(v, width, height).color for v in (a, b)]  # warm-up
+    for _ in range(frames):
+        for i, v in enumerate((a, b)):
+            state = v.setup(width, height)
+            t0 = time.perf_counter()
+            render_variant(v, width, height, state)
+            times[i].append((time.perf_counter() - t0) * 1e3)
+            del state
+    return times[0], times[1], images
+
+
+def compare_images(kind: str, a: np.ndarray, b: np.ndarray) -> str:
+    """'identical', or the largest difference; raises AssertionError when `kind` promises more."""
+    diff = float(np.max(np.abs(a.astype(np.float64) - b.astype(np.float64)))) if a.shape == b.shape else np.inf
+    if kind == "exact" and diff != 0.0:
+        raise AssertionError(f"images differ (max |diff| {diff:.3g}) where they should be identical")
+    if kind == "close" and not diff <= CLOSE_TOLERANCE:
+        raise AssertionError(f"images differ by {diff:.3g} > {CLOSE_TOLERANCE:g}")
+    return "identical" if diff == 0.0 else f"max |diff| {diff:.2g}"
+
+
+def measure(width: int, height: int, frames: int) -> List[Row]:
+    """Every row of OMISSIONS at one thread, pinned to one CPU."""
+    rows = []
+    with pinned_to_one_cpu():
+        for om in OMISSIONS:
+            row = Row(om.name, om.scene, om.with_it.label, om.without.label if om.without else "–", note=om.note,
+                      forced=om.forced)
+            if om.without is not None:
+                a, b, images = time_pair(om.with_it, om.without, width, height, frames)
+                row.with_ms, row.without_ms = statistics.median(a), statistics.median(b)
+                row.samples = {"with_ms": a, "without_ms": b}
+                row.with_memory = render_memory(om.with_it, width, height)
+                row.without_memory = render_memory(om.without, width, height)
+                if om.same_image:
+                    row.image_check = compare_images(om.same_image, *images)
+            print(f"omission {row.name}: {row.with_ms} / {row.without_ms} ms", file=sys.stderr)
+            rows.append(row)
+    return rows
+
+
+def markdown(rows: List[Row], width: int, height: int) -> str:
+    """The omission table."""
+    mib = lambda v: "–" if v is None else f"{v / 2**20:,.1f}"  # noqa: E731
+    ms = lambda v: "–" if v is None else f"{v:,.2f}"  # noqa: E731
+    lines = [f"Omissions at {width}×{height}, 1 thread (median ms; memory = resident-set growth during a frame, MiB):",
+             "", "| omission | scene | with it | ms | MiB | without (forced work) | ms | MiB | saves | same image |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r.with_ms is None or r.without_ms is None:
+            saves = "–"
+        elif not r.forced:
+            saves = f"n/a (costs {r.with_ms / r.without_ms - 1:+.0%})"
+        else:
+            saves = f"{1 - r.with_ms / r.without_ms:+.0%}"
+        lines.append(f"| {r.name} | {r.scene} | {r.with_label} | {ms(r.with_ms)} | {mib(r.with_memory)} | "
+                     f"{r.without_label} | {ms(r.without_ms)} | {mib(r.without_memory)} | {saves} | "
+                     f"{r.image_check or '–'} |")
+    notes = [f"- {r.name}: {r.note}" for r in rows if r.note]
+    return "\n".join(lines + [""] + notes) + "\n"
+
+
+def run(out_dir: str, quick: bool = False) -> List[Row]:
+    """Measures the table; prints and writes omissions.md and omissions.json to out_dir."""
+    width, height = QUICK_SIZE if quick else SIZE
+    rows = measure(width, height, 3 if quick else 15)
+    table = markdown(rows, width, height)
+    print(table)
+    with open(os.path.join(out_dir, "omissions.md"), "w") as f:
+        f.write(table)
+    with open(os.path.join(out_dir, "omissions.json"), "w") as f:
+        json.dump({"width": width, "height": height, "rows": [asdict(r) for r in rows]}, f, indent=1)
+    return rows
