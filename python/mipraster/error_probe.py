@@ -1,0 +1,151 @@
+"""A render's error measured against a sparse reference: a few hundred of its pixels rendered again
+at reference quality.
+
+The halves estimate (two interleaved halves of each pixel's samples, ``RenderSettings.estimate_error``)
+says *where* a render is uncertain, but it cannot see error that both halves share (the blur of a
+mip-mapped filter, MSAA's one shade per pixel), it is noisy with few samples per half and it gives
+nothing at one sample per pixel. The probe says *how much*, for any scene and configuration:
+
+1. Choose n pixels at random, i.i.d. with probability p_i = ½/N + ½·m_i²/Σm² (m: the halves map
+   when the render has one, else p_i = 1/N): half the draws where the halves see error, half
+   uniform, so error the halves cannot see is still found. The generator is seeded; the choice does
+   not depend on the thread count.
+2. Render those pixels again in two passes of the C++ renderer (``RenderSettings.pixels``: one
+   transform and setup each), each with 64 stratified samples per pixel of its own seed, every
+   sample shaded (SSAA) and every texture read at level 0 with bilinear reconstruction: each
+   sample is a point of the pixel's box-filtered footprint integral, the quantity the study's
+   references integrate. The reference R_i is the mean of the two passes R_i¹, R_i²; their
+   errors are independent, so v_i² = (R_i¹ − R_i²)²/4 estimates R_i's own squared error without
+   bias (a split of one pass into halves would not: stratified halves overstate it).
+3. d_i² = mean over R, G, B of (render_i − R_i)² − v_i² is an unbiased estimate of the pixel's
+   squared error (the render's and the reference's sample errors are independent), and
+   MSE = (1/n)·Σ_k d_k²/(N·p_k) an unbiased estimate of the image's mean squared error; the
+   spread of the n terms gives its standard error.
+
+The cost is n pixels × 2 × 64 samples plus two setups of the scene, reported in ``ms``; by default
+n = W·H·S/512 (a quarter of the render's samples) kept within [64, 1024].
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import numpy as np
+
+from . import _core
+
+__all__ = ["ErrorProbe", "default_pixel_count", "measure_error", "reference_scene"]
+
+REFERENCE_SPP = 64  # _core.MAX_SAMPLES: the most samples one pass gives a pixel
+REFERENCE_PASSES = 2  # independent passes: their disagreement is the reference's own error
+# Distinct from any pattern seed a user is likely to pick, so the reference's samples are not the
+# render's own (the estimate needs their errors independent).
+REFERENCE_SEED = 0x9E3779B97F4A7C15
+MIN_PIXELS, MAX_PIXELS = 64, 1024  # enough pixels to find sparse edges; a bounded cost
+
+
+@dataclass(frozen=True)
+class ErrorProbe:
+    """What the sparse reference measured.
+
+    Attributes:
+        rmse: the estimated RMSE of the image (linear R, G, B); 0 when the estimate of the mean
+            squared error came out ≤ 0 (an image more accurate than the probe can tell).
+        stderr: the standard error of ``rmse`` (from the spread of the per-pixel terms).
+        pixels: the number of draws n (a pixel drawn twice counts twice).
+        distinct_pixels: the pixels rendered again.
+        reference_spp: samples per pixel of the reference (all passes).
+        halves_rmse: the halves estimate of the whole image (None without a halves map).
+        ms: wall time of the probe (choice, reference pass, arithmetic) in milliseconds.
+    """
+
+    rmse: float
+    stderr: float
+    pixels: int
+    distinct_pixels: int
+    reference_spp: int
+    halves_rmse: Optional[float]
+    ms: float
+
+    def __repr__(self) -> str:
+        halves = "" if self.halves_rmse is None else f", halves_rmse={self.halves_rmse:.4g}"
+        return (f"ErrorProbe(rmse={self.rmse:.4g} ± {self.stderr:.2g}, pixels={self.pixels} "
+                f"({self.distinct_pixels} distinct) at {self.reference_spp} spp{halves}, ms={self.ms:.2f})")
+
+
+def default_pixel_count(width: int, height: int, spp: int) -> int:
+    """The pixels a probe renders by default: a quarter of the render's samples at 2 × 64 samples
+    each, at least 64 and at most 1024."""
+    budget = width * height * spp / (4 * REFERENCE_SPP * REFERENCE_PASSES)
+    return int(min(MAX_PIXELS, max(MIN_PIXELS, round(budget))))
+
+
+def reference_scene(scene: Any) -> Any:
+    """A copy of ``scene`` whose textured draws read level 0 with bilinear reconstruction (wrap,
+    border colour and everything else kept)."""
+    from .scene import Scene
+
+    out = Scene()
+    out.clear_color = scene.clear_color
+    for d in scene.draws:
+        sampler = None
+        if d.texture is not None:
+            sampler = dataclasses.replace(d.sampler, filter="bilinear", mag_filter=None, min_filter=None,
+                                          mip_filter=None)
+        out.add(d.mesh, model=d.model, color=d.color, depth_test=d.depth_test, depth_write=d.depth_write,
+                blend=d.blend, interpolation=d.interpolation, cull=d.cull, texture=d.texture, sampler=sampler)
+    return out
+
+
+def measure_error(scene: Any, camera: Any, settings: Any, color: np.ndarray, halves_map: Optional[np.ndarray],
+                  pixels: int, seed: int = 0) -> ErrorProbe:
+    """Estimates the RMSE of ``color`` (H, W, ≥3, linear), the render of ``scene`` (a
+    :class:`mipraster.Scene`) through the core ``camera`` with core ``settings``, from ``pixels``
+    pixels rendered again at reference quality (see the module docstring). ``halves_map`` (H, W)
+    guides the choice of pixels; ``seed`` makes another choice."""
+    from .scene import _core_draws
+
+    start = time.perf_counter()
+    h, w = color.shape[:2]
+    n_all = w * h
+    if not (isinstance(pixels, int) and pixels >= 1):
+        raise ValueError(f"probe_pixels: expected a number of pixels >= 1, got {pixels!r}")
+    p = np.full(n_all, 1.0 / n_all)
+    halves_rmse = None
+    if halves_map is not None:
+        m2 = np.asarray(halves_map, dtype=np.float64).ravel() ** 2
+        halves_rmse = float(math.sqrt(m2.mean()))
+        if m2.sum() > 0:
+            p = 0.5 * p + 0.5 * m2 / m2.sum()
+    rng = np.random.Generator(np.random.PCG64([seed, w, h, pixels]))
+    chosen = rng.choice(n_all, size=pixels, p=p)
+    distinct = np.unique(chosen)
+
+    ref = _core.RenderSettings()
+    ref.width, ref.height, ref.samples = w, h, REFERENCE_SPP
+    ref.pattern = _core.PatternKind.stratified
+    ref.anti_aliasing = _core.AntiAliasing.ssaa
+    ref.threads, ref.clear_color = settings.threads, settings.clear_color
+    ref.derivatives, ref.debug_view = settings.derivatives, settings.debug_view
+    ref.pixels = distinct.tolist()
+    draws = _core_draws(reference_scene(scene))
+    ys, xs = np.divmod(chosen, w)
+    passes = []
+    for k in range(REFERENCE_PASSES):
+        ref.pattern_seed = (REFERENCE_SEED + k) ^ seed
+        passes.append(_core.render(draws, camera, ref)["color"][ys, xs, :3].astype(np.float64))
+    reference = (passes[0] + passes[1]) / 2
+    own = ((passes[0] - passes[1]) ** 2).mean(axis=1) / 4  # E[own] = the reference's squared error
+    diff = np.asarray(color, dtype=np.float64)[ys, xs, :3] - reference
+    terms = ((diff * diff).mean(axis=1) - own) / (n_all * p[chosen])
+    mse = float(terms.mean())
+    mse_se = float(terms.std(ddof=1) / math.sqrt(pixels)) if pixels > 1 else math.inf
+    rmse = math.sqrt(max(mse, 0.0))
+    # The delta method where the RMSE is well above its noise; √(standard error of the MSE) near 0.
+    stderr = mse_se / (2.0 * rmse) if rmse > 0 and mse_se < mse else math.sqrt(mse_se)
+    return ErrorProbe(rmse=rmse, stderr=stderr, pixels=pixels, distinct_pixels=int(distinct.size),
+                      reference_spp=REFERENCE_SPP * REFERENCE_PASSES, halves_rmse=halves_rmse,
+                      ms=(time.perf_counter() - start) * 1000.0)
