@@ -1,16 +1,20 @@
 """Adaptive quality: more samples only for the pixels whose estimated error needs them.
 
-A first pass renders the image at the requested samples per pixel S₀ with the error estimate on:
-the halves map, scaled by the probe so that its root mean square is the image's measured error
-(:mod:`mipraster.error_probe`). With error ∝ 1/√S, raising pixel i from s_i to S samples lowers its
-squared error e_i² by e_i²·(1 − s_i/S). For each candidate count S (S₀·2^k, up to 64) the pixels
-with the largest gains are taken until the image's estimated mean squared error meets the target
-T²; the candidate with the fewest new samples (pixels × S) wins, and only those pixels are rendered
-again, in one pass of the C++ renderer (``RenderSettings.pixels``: one transform and setup, each
-row of chosen pixels in a tile one span). Their colour and estimate replace the first pass's. The
-rounds go on (at most ``MAX_PASSES`` refinement passes) while the estimate misses the target and
-some pixel with error has fewer than 64 samples. Pixels with no estimated error (flat colour) are
-never rendered again.
+A first pass renders the image at the requested samples per pixel S₀ with the halves map on, and
+the probe (:mod:`mipraster.error_probe`) measures the image's error E. The per-pixel estimate is the
+probe's guide (the halves map squared and spread over 3×3 neighbourhoods, plus the squared colour
+step to the neighbours: error the halves miss at few samples) scaled so that its root mean square
+is E. With error ∝
+1/√S, raising pixel i from s_i to S samples lowers its squared error e_i² by e_i²·(1 − s_i/S). For
+each candidate count S (S₀·2^k, up to 64) the pixels with the largest gains are taken until the
+image's predicted mean squared error meets the target T²; the candidate with the fewest new samples
+(pixels × S) wins, and only those pixels are rendered again, in one pass of the C++ renderer
+(``RenderSettings.pixels``: one transform and setup, each row of chosen pixels in a tile one span).
+Their colour and halves replace the first pass's, and the probe measures the new image. The rounds
+go on (at most ``MAX_PASSES`` refinement passes) while the measured error misses the target and some
+pixel with estimated error has fewer than 64 samples. The error reported is always the probe's
+measurement of the returned image. Pixels with no estimated error nearby (flat colour) are never
+rendered again.
 """
 from __future__ import annotations
 
@@ -66,7 +70,8 @@ def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings
     Raises ValueError for a target that is not a finite number > 0, with ``keep_samples`` or with
     a resolve filter other than box.
     """
-    from .render import RenderResult, calibrate
+    from .error_probe import guide, measure_error
+    from .render import RenderResult
 
     target = _checks.real(target_error, "target_error")
     if not (math.isfinite(target) and target > 0.0):
@@ -79,16 +84,23 @@ def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings
     start = time.perf_counter()
     settings.estimate_error = True
     raw = _core.render(draws, camera, settings)
-    scale = calibrate(raw, scene, camera, settings, probe_pixels) if probe_pixels > 0 else 1.0
     color, depth = raw["color"], raw["depth"]
-    error = raw["error_map"].astype(np.float64)
+    halves = raw["error_map"].astype(np.float64)
     stats = dict(raw["stats"])
     base = settings.samples
-    spp = np.full(error.shape, base, dtype=np.int64)
+    spp = np.full(halves.shape, base, dtype=np.int64)
     base_pattern = settings.pattern
-    for _ in range(MAX_PASSES):
-        if float(np.mean(error ** 2)) <= target * target:
+    probe = None
+    for passes in range(MAX_PASSES + 1):
+        if probe_pixels > 0:
+            probe = measure_error(scene, camera, settings, color, halves, probe_pixels, seed=settings.pattern_seed)
+            measured = probe.rmse
+        else:
+            measured = float(np.sqrt(np.mean(halves ** 2)))
+        likely = guide(color, halves)
+        if measured <= target or passes == MAX_PASSES or not likely.any():
             break
+        error = np.sqrt(likely * (measured * measured / likely.mean()))  # root mean square = measured
         plan = plan_refinement(error, spp, target, base)
         if plan is None:
             break
@@ -99,17 +111,20 @@ def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings
         settings.pixels = np.flatnonzero(mask).tolist()
         again = _core.render(draws, camera, settings)
         color[mask] = again["color"][mask]
-        error[mask] = again["error_map"][mask].astype(np.float64) * scale
+        halves[mask] = again["error_map"][mask]
         if depth is not None and again["depth"] is not None:
             depth[mask] = again["depth"][mask]
         for key, value in again["stats"].items():
             if key != "threads":
                 stats[key] += value
         spp[mask] = s
+        settings.samples, settings.pattern, settings.pixels = base, base_pattern, []
     settings.samples, settings.pattern, settings.pixels = base, base_pattern, []
-    stats["total_ms"] = (time.perf_counter() - start) * 1000.0  # every pass, the probe and the bookkeeping
+    stats["total_ms"] = (time.perf_counter() - start) * 1000.0  # every pass, every probe, the bookkeeping
+    halves_rmse = float(np.sqrt(np.mean(halves ** 2)))
     raw["color"], raw["depth"], raw["stats"] = color, depth, stats
-    raw["error_map"] = error.astype(np.float32)
-    raw["error_estimate"] = float(np.sqrt(np.mean(error ** 2)))
+    raw["error_estimate"] = measured
+    raw["error_map"] = (halves * (measured / halves_rmse if halves_rmse > 0 else 1.0)).astype(np.float32)
+    raw["error_probe"] = probe
     raw["pixel_spp"] = spp
     return RenderResult(raw)

@@ -6,24 +6,27 @@ says *where* a render is uncertain, but it cannot see error that both halves sha
 mip-mapped filter, MSAA's one shade per pixel), it is noisy with few samples per half and it gives
 nothing at one sample per pixel. The probe says *how much*, for any scene and configuration:
 
-1. Choose n pixels at random, i.i.d. with probability p_i = ½/N + ½·m_i²/Σm² (m: the halves map
-   when the render has one, else p_i = 1/N): half the draws where the halves see error, half
-   uniform, so error the halves cannot see is still found. The generator is seeded; the choice does
-   not depend on the thread count.
-2. Render those pixels again in two passes of the C++ renderer (``RenderSettings.pixels``: one
+1. Choose n pixels at random, i.i.d. with probability p_i = ½/N + ½·g_i/Σg, where the guide g is
+   where error is likely: the halves map squared and spread over each pixel's 3×3 neighbourhood
+   (an edge pixel whose halves happen to agree lies next to one whose halves do not) plus the
+   squared colour step to the pixel's 4 neighbours (edges and texture detail, at any spp). Half
+   the draws are uniform, so error the guide misses is still found. The generator is seeded; the
+   choice does not depend on the thread count.
+2. Render those pixels again in K ≥ 2 passes of the C++ renderer (``RenderSettings.pixels``: one
    transform and setup each), each with 64 stratified samples per pixel of its own seed, every
    sample shaded (SSAA) and every texture read at level 0 with bilinear reconstruction: each
    sample is a point of the pixel's box-filtered footprint integral, the quantity the study's
-   references integrate. The reference R_i is the mean of the two passes R_i¹, R_i²; their
-   errors are independent, so v_i² = (R_i¹ − R_i²)²/4 estimates R_i's own squared error without
-   bias (a split of one pass into halves would not: stratified halves overstate it).
+   references integrate. The reference R_i is the mean of the passes; their errors are
+   independent, so v_i² = Σ_k (R_i^k − R_i)²/(K·(K − 1)) estimates R_i's own squared error without
+   bias (a split of one pass into halves would not: stratified halves overstate it). K = 2, and
+   K = 2·S/32 for S > 32 samples per pixel, so the reference stays finer than the render.
 3. d_i² = mean over R, G, B of (render_i − R_i)² − v_i² is an unbiased estimate of the pixel's
    squared error (the render's and the reference's sample errors are independent), and
    MSE = (1/n)·Σ_k d_k²/(N·p_k) an unbiased estimate of the image's mean squared error; the
    spread of the n terms gives its standard error.
 
-The cost is n pixels × 2 × 64 samples plus two setups of the scene, reported in ``ms``; by default
-n = W·H·S/512 (a quarter of the render's samples) kept within [64, 1024].
+The cost is n pixels × K × 64 samples plus K setups of the scene, reported in ``ms``; by default
+n = W·H·S/(K·256) (a quarter of the render's samples) kept within [64, 1024].
 """
 from __future__ import annotations
 
@@ -37,10 +40,11 @@ import numpy as np
 
 from . import _core
 
-__all__ = ["ErrorProbe", "default_pixel_count", "measure_error", "reference_scene"]
+__all__ = ["ErrorProbe", "default_pixel_count", "guide", "measure_error", "reference_passes", "reference_scene",
+           "spread"]
 
 REFERENCE_SPP = 64  # _core.MAX_SAMPLES: the most samples one pass gives a pixel
-REFERENCE_PASSES = 2  # independent passes: their disagreement is the reference's own error
+MIN_PASSES = 2  # independent passes: their disagreement is the reference's own error
 # Distinct from any pattern seed a user is likely to pick, so the reference's samples are not the
 # render's own (the estimate needs their errors independent).
 REFERENCE_SEED = 0x9E3779B97F4A7C15
@@ -76,11 +80,40 @@ class ErrorProbe:
                 f"({self.distinct_pixels} distinct) at {self.reference_spp} spp{halves}, ms={self.ms:.2f})")
 
 
+def reference_passes(spp: int) -> int:
+    """Passes of 64 samples the reference of a render with ``spp`` samples per pixel gets."""
+    return max(MIN_PASSES, 2 * spp // 32)
+
+
 def default_pixel_count(width: int, height: int, spp: int) -> int:
-    """The pixels a probe renders by default: a quarter of the render's samples at 2 × 64 samples
-    each, at least 64 and at most 1024."""
-    budget = width * height * spp / (4 * REFERENCE_SPP * REFERENCE_PASSES)
+    """The pixels a probe renders by default: a quarter of the render's samples at
+    ``reference_passes(spp)`` × 64 samples each, at least 64 and at most 1024."""
+    budget = width * height * spp / (4 * REFERENCE_SPP * reference_passes(spp))
     return int(min(MAX_PIXELS, max(MIN_PIXELS, round(budget))))
+
+
+def guide(color: np.ndarray, halves_map: Optional[np.ndarray]) -> np.ndarray:
+    """Where error is likely, (H, W) ≥ 0: the halves map squared, spread over 3×3 neighbourhoods,
+    plus the largest squared half colour step (mean over R, G, B) to the 4 neighbours."""
+    c = np.asarray(color, dtype=np.float64)[..., :3]
+    step = np.zeros(c.shape[:2])
+    for axis in (0, 1):
+        d = (np.diff(c, axis=axis) ** 2).mean(axis=2) / 4
+        lo = [slice(None)] * 2
+        hi = [slice(None)] * 2
+        lo[axis], hi[axis] = slice(None, -1), slice(1, None)
+        step[tuple(lo)] = np.maximum(step[tuple(lo)], d)
+        step[tuple(hi)] = np.maximum(step[tuple(hi)], d)
+    if halves_map is None:
+        return step
+    return step + spread(np.asarray(halves_map, dtype=np.float64) ** 2)
+
+
+def spread(a: np.ndarray) -> np.ndarray:
+    """The mean of ``a`` (H, W) over each pixel's 3×3 neighbourhood (zero outside the image)."""
+    h, w = a.shape
+    padded = np.pad(np.asarray(a, dtype=np.float64), 1)
+    return sum(padded[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)) / 9
 
 
 def reference_scene(scene: Any) -> Any:
@@ -116,10 +149,10 @@ def measure_error(scene: Any, camera: Any, settings: Any, color: np.ndarray, hal
     p = np.full(n_all, 1.0 / n_all)
     halves_rmse = None
     if halves_map is not None:
-        m2 = np.asarray(halves_map, dtype=np.float64).ravel() ** 2
-        halves_rmse = float(math.sqrt(m2.mean()))
-        if m2.sum() > 0:
-            p = 0.5 * p + 0.5 * m2 / m2.sum()
+        halves_rmse = float(math.sqrt(np.mean(np.asarray(halves_map, dtype=np.float64) ** 2)))
+    g = guide(color, halves_map).ravel()
+    if g.sum() > 0:
+        p = 0.5 * p + 0.5 * g / g.sum()
     rng = np.random.Generator(np.random.PCG64([seed, w, h, pixels]))
     chosen = rng.choice(n_all, size=pixels, p=p)
     distinct = np.unique(chosen)
@@ -133,12 +166,14 @@ def measure_error(scene: Any, camera: Any, settings: Any, color: np.ndarray, hal
     ref.pixels = distinct.tolist()
     draws = _core_draws(reference_scene(scene))
     ys, xs = np.divmod(chosen, w)
+    k_passes = reference_passes(settings.samples)
     passes = []
-    for k in range(REFERENCE_PASSES):
+    for k in range(k_passes):
         ref.pattern_seed = (REFERENCE_SEED + k) ^ seed
         passes.append(_core.render(draws, camera, ref)["color"][ys, xs, :3].astype(np.float64))
-    reference = (passes[0] + passes[1]) / 2
-    own = ((passes[0] - passes[1]) ** 2).mean(axis=1) / 4  # E[own] = the reference's squared error
+    reference = sum(passes) / k_passes
+    # E[own] = the reference's squared error (the sample variance of the passes' mean).
+    own = (sum((q - reference) ** 2 for q in passes).mean(axis=1)) / (k_passes * (k_passes - 1))
     diff = np.asarray(color, dtype=np.float64)[ys, xs, :3] - reference
     terms = ((diff * diff).mean(axis=1) - own) / (n_all * p[chosen])
     mse = float(terms.mean())
@@ -147,5 +182,5 @@ def measure_error(scene: Any, camera: Any, settings: Any, color: np.ndarray, hal
     # The delta method where the RMSE is well above its noise; √(standard error of the MSE) near 0.
     stderr = mse_se / (2.0 * rmse) if rmse > 0 and mse_se < mse else math.sqrt(mse_se)
     return ErrorProbe(rmse=rmse, stderr=stderr, pixels=pixels, distinct_pixels=int(distinct.size),
-                      reference_spp=REFERENCE_SPP * REFERENCE_PASSES, halves_rmse=halves_rmse,
+                      reference_spp=REFERENCE_SPP * k_passes, halves_rmse=halves_rmse,
                       ms=(time.perf_counter() - start) * 1000.0)
