@@ -37,29 +37,29 @@ def plan_refinement(error: np.ndarray, spp: np.ndarray, target: float, base: int
     ``target`` under error ∝ 1/√spp, or, when no candidate S reaches it, every pixel with error at
     64. None when no pixel with error can get more samples."""
     e2 = np.asarray(error, dtype=np.float64) ** 2
-    spp = np.asarray(spp)
     need = e2.sum() - target * target * e2.size  # the squared error to remove, summed over pixels
+    some = np.flatnonzero(e2 > 0)  # only pixels with error can gain
+    e2_some, spp_some = e2.ravel()[some], np.asarray(spp).ravel()[some]
     candidates = sorted({base * 2 ** k for k in range(1, 7) if base * 2 ** k <= _core.MAX_SAMPLES}
                         | {_core.MAX_SAMPLES})
     best = None
     for s in candidates:
-        eligible = (e2 > 0) & (spp < s)
+        eligible = spp_some < s
         if not eligible.any():
             continue
-        gain = np.where(eligible, e2 * (1.0 - spp / s), 0.0).ravel()
+        gain = np.where(eligible, e2_some * (1.0 - spp_some / s), 0.0)
         order = np.argsort(-gain, kind="stable")  # largest gain first; ties in pixel order
-        total = np.cumsum(gain[order])
-        k = int(np.searchsorted(total, need * (1 - 1e-12))) + 1
+        k = int(np.searchsorted(np.cumsum(gain[order]), need * (1 - 1e-12))) + 1
         if k > int(eligible.sum()):
             continue  # this count cannot reach the target
         if best is None or k * s < best[0]:
-            mask = np.zeros(e2.size, dtype=bool)
-            mask[order[:k]] = True
-            best = (k * s, mask.reshape(e2.shape), s)
+            best = (k * s, some[order[:k]], s)
+    mask = np.zeros(e2.size, dtype=bool)
     if best is not None:
-        return best[1], best[2]
-    eligible = (e2 > 0) & (spp < _core.MAX_SAMPLES)
-    return (eligible, _core.MAX_SAMPLES) if eligible.any() else None
+        mask[best[1]] = True
+        return mask.reshape(e2.shape), best[2]
+    mask[some[spp_some < _core.MAX_SAMPLES]] = True
+    return (mask.reshape(e2.shape), _core.MAX_SAMPLES) if mask.any() else None
 
 
 def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings: Any, target_error: Any,
@@ -85,22 +85,23 @@ def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings
     settings.estimate_error = True
     raw = _core.render(draws, camera, settings)
     color, depth = raw["color"], raw["depth"]
-    halves = raw["error_map"].astype(np.float64)
+    halves = raw["error_map"]  # float32
     stats = dict(raw["stats"])
     base = settings.samples
     spp = np.full(halves.shape, base, dtype=np.int64)
     base_pattern = settings.pattern
     probe = None
     for passes in range(MAX_PASSES + 1):
+        likely = guide(color, halves)
         if probe_pixels > 0:
-            probe = measure_error(scene, camera, settings, color, halves, probe_pixels, seed=settings.pattern_seed)
+            probe = measure_error(scene, camera, settings, color, halves, probe_pixels, seed=settings.pattern_seed,
+                                  guide_map=likely)
             measured = probe.rmse
         else:
-            measured = float(np.sqrt(np.mean(halves ** 2)))
-        likely = guide(color, halves)
+            measured = float(np.sqrt(np.mean(halves ** 2, dtype=np.float64)))
         if measured <= target or passes == MAX_PASSES or not likely.any():
             break
-        error = np.sqrt(likely * (measured * measured / likely.mean()))  # root mean square = measured
+        error = np.sqrt(likely * (measured * measured / likely.mean(dtype=np.float64)))  # its RMS: measured
         plan = plan_refinement(error, spp, target, base)
         if plan is None:
             break
@@ -121,7 +122,7 @@ def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings
         settings.samples, settings.pattern, settings.pixels = base, base_pattern, []
     settings.samples, settings.pattern, settings.pixels = base, base_pattern, []
     stats["total_ms"] = (time.perf_counter() - start) * 1000.0  # every pass, every probe, the bookkeeping
-    halves_rmse = float(np.sqrt(np.mean(halves ** 2)))
+    halves_rmse = float(np.sqrt(np.mean(halves ** 2, dtype=np.float64)))
     raw["color"], raw["depth"], raw["stats"] = color, depth, stats
     raw["error_estimate"] = measured
     raw["error_map"] = (halves * (measured / halves_rmse if halves_rmse > 0 else 1.0)).astype(np.float32)

@@ -95,25 +95,27 @@ def default_pixel_count(width: int, height: int, spp: int) -> int:
 def guide(color: np.ndarray, halves_map: Optional[np.ndarray]) -> np.ndarray:
     """Where error is likely, (H, W) ≥ 0: the halves map squared, spread over 3×3 neighbourhoods,
     plus the largest squared half colour step (mean over R, G, B) to the 4 neighbours."""
-    c = np.asarray(color, dtype=np.float64)[..., :3]
-    step = np.zeros(c.shape[:2])
-    for axis in (0, 1):
-        d = (np.diff(c, axis=axis) ** 2).mean(axis=2) / 4
-        lo = [slice(None)] * 2
-        hi = [slice(None)] * 2
-        lo[axis], hi[axis] = slice(None, -1), slice(1, None)
-        step[tuple(lo)] = np.maximum(step[tuple(lo)], d)
-        step[tuple(hi)] = np.maximum(step[tuple(hi)], d)
+    c = np.asarray(color)[..., :3]
+    step = np.zeros(c.shape[:2], dtype=np.float32)
+    down, right = c[1:] - c[:-1], c[:, 1:] - c[:, :-1]
+    down = np.einsum("ijk,ijk->ij", down, down) / 12  # mean over R, G, B of (half the step)²
+    right = np.einsum("ijk,ijk->ij", right, right) / 12
+    np.maximum(step[1:], down, out=step[1:])
+    np.maximum(step[:-1], down, out=step[:-1])
+    np.maximum(step[:, 1:], right, out=step[:, 1:])
+    np.maximum(step[:, :-1], right, out=step[:, :-1])
     if halves_map is None:
         return step
-    return step + spread(np.asarray(halves_map, dtype=np.float64) ** 2)
+    m = np.asarray(halves_map, dtype=np.float32)
+    return step + spread(m * m)
 
 
 def spread(a: np.ndarray) -> np.ndarray:
     """The mean of ``a`` (H, W) over each pixel's 3×3 neighbourhood (zero outside the image)."""
     h, w = a.shape
-    padded = np.pad(np.asarray(a, dtype=np.float64), 1)
-    return sum(padded[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)) / 9
+    padded = np.pad(a, 1)
+    rows = padded[:-2] + padded[1:-1] + padded[2:]  # separable: 3 rows, then 3 columns
+    return (rows[:, :-2] + rows[:, 1:-1] + rows[:, 2:]) / 9
 
 
 def reference_scene(scene: Any) -> Any:
@@ -134,11 +136,12 @@ def reference_scene(scene: Any) -> Any:
 
 
 def measure_error(scene: Any, camera: Any, settings: Any, color: np.ndarray, halves_map: Optional[np.ndarray],
-                  pixels: int, seed: int = 0) -> ErrorProbe:
+                  pixels: int, seed: int = 0, guide_map: Optional[np.ndarray] = None) -> ErrorProbe:
     """Estimates the RMSE of ``color`` (H, W, ≥3, linear), the render of ``scene`` (a
     :class:`mipraster.Scene`) through the core ``camera`` with core ``settings``, from ``pixels``
     pixels rendered again at reference quality (see the module docstring). ``halves_map`` (H, W)
-    guides the choice of pixels; ``seed`` makes another choice."""
+    is the render's halves map or None; ``guide_map`` is ``guide(color, halves_map)`` when the
+    caller has it; ``seed`` makes another choice."""
     from .scene import _core_draws
 
     start = time.perf_counter()
@@ -150,7 +153,7 @@ def measure_error(scene: Any, camera: Any, settings: Any, color: np.ndarray, hal
     halves_rmse = None
     if halves_map is not None:
         halves_rmse = float(math.sqrt(np.mean(np.asarray(halves_map, dtype=np.float64) ** 2)))
-    g = guide(color, halves_map).ravel()
+    g = (guide(color, halves_map) if guide_map is None else guide_map).astype(np.float64).ravel()
     if g.sum() > 0:
         p = 0.5 * p + 0.5 * g / g.sum()
     rng = np.random.Generator(np.random.PCG64([seed, w, h, pixels]))
