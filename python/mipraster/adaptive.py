@@ -42,13 +42,16 @@ def plan_refinement(error: np.ndarray, spp: np.ndarray, target: float, base: int
     e2_some, spp_some = e2.ravel()[some], np.asarray(spp).ravel()[some]
     candidates = sorted({base * 2 ** k for k in range(1, 7) if base * 2 ** k <= _core.MAX_SAMPLES}
                         | {_core.MAX_SAMPLES})
+    # With equal sample counts every candidate ranks the pixels alike: sort once.
+    uniform = np.argsort(-e2_some, kind="stable") if np.all(spp_some == spp_some[:1]) else None
     best = None
     for s in candidates:
         eligible = spp_some < s
         if not eligible.any():
             continue
         gain = np.where(eligible, e2_some * (1.0 - spp_some / s), 0.0)
-        order = np.argsort(-gain, kind="stable")  # largest gain first; ties in pixel order
+        # Largest gain first; ties in pixel order.
+        order = uniform if uniform is not None else np.argsort(-gain, kind="stable")
         k = int(np.searchsorted(np.cumsum(gain[order]), need * (1 - 1e-12))) + 1
         if k > int(eligible.sum()):
             continue  # this count cannot reach the target
@@ -91,8 +94,12 @@ def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings
     spp = np.full(halves.shape, base, dtype=np.int64)
     base_pattern = settings.pattern
     probe = None
+    likely = None
     for passes in range(MAX_PASSES + 1):
-        likely = guide(color, halves)
+        # The probe may choose its pixels by any guide that is not the reference's: the latest
+        # guide, but only computed again when a pass is to be planned on it.
+        if likely is None:
+            likely = guide(color, halves)
         if probe_pixels > 0:
             probe = measure_error(scene, camera, settings, color, halves, probe_pixels, seed=settings.pattern_seed,
                                   guide_map=likely)
@@ -101,6 +108,8 @@ def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings
             measured = float(np.sqrt(np.mean(halves ** 2, dtype=np.float64)))
         if measured <= target or passes == MAX_PASSES or not likely.any():
             break
+        if passes > 0:
+            likely = guide(color, halves)
         error = np.sqrt(likely * (measured * measured / likely.mean(dtype=np.float64)))  # its RMS: measured
         plan = plan_refinement(error, spp, target, base)
         if plan is None:

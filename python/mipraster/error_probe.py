@@ -149,15 +149,16 @@ def measure_error(scene: Any, camera: Any, settings: Any, color: np.ndarray, hal
     n_all = w * h
     if not (isinstance(pixels, int) and pixels >= 1):
         raise ValueError(f"probe_pixels: expected a number of pixels >= 1, got {pixels!r}")
-    p = np.full(n_all, 1.0 / n_all)
     halves_rmse = None
     if halves_map is not None:
         halves_rmse = float(math.sqrt(np.mean(np.asarray(halves_map, dtype=np.float64) ** 2)))
     g = (guide(color, halves_map) if guide_map is None else guide_map).astype(np.float64).ravel()
-    if g.sum() > 0:
-        p = 0.5 * p + 0.5 * g / g.sum()
+    total = g.sum()
+    weight = 0.5 / n_all + 0.5 * g / total if total > 0 else np.full(n_all, 1.0 / n_all)
+    cdf = np.cumsum(weight)
+    p = weight / cdf[-1]  # the probability of drawing each pixel
     rng = np.random.Generator(np.random.PCG64([seed, w, h, pixels]))
-    chosen = rng.choice(n_all, size=pixels, p=p)
+    chosen = np.minimum(np.searchsorted(cdf, rng.random(pixels) * cdf[-1], side="right"), n_all - 1)
     distinct = np.unique(chosen)
 
     ref = _core.RenderSettings()
