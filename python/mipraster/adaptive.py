@@ -73,7 +73,7 @@ def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings
     Raises ValueError for a target that is not a finite number > 0, with ``keep_samples`` or with
     a resolve filter other than box.
     """
-    from .error_probe import guide, measure_error
+    from .error_probe import guide, measure_error, rms
     from .render import RenderResult
 
     target = _checks.real(target_error, "target_error")
@@ -105,12 +105,12 @@ def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings
                                   guide_map=likely)
             measured = probe.rmse
         else:
-            measured = float(np.sqrt(np.mean(halves ** 2, dtype=np.float64)))
+            measured = rms(halves)
         if measured <= target or passes == MAX_PASSES or not likely.any():
             break
         if passes > 0:
             likely = guide(color, halves)
-        error = np.sqrt(likely * (measured * measured / likely.mean(dtype=np.float64)))  # its RMS: measured
+        error = np.sqrt(likely * np.float32(measured * measured / likely.mean(dtype=np.float64)))  # RMS: measured
         plan = plan_refinement(error, spp, target, base)
         if plan is None:
             break
@@ -118,20 +118,21 @@ def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings
         settings.samples = s
         if settings.pattern == _core.PatternKind.rotated:
             settings.pattern = _core.PatternKind.grid  # the rotated pattern has 4 samples only
-        settings.pixels = np.flatnonzero(mask).tolist()
+        chosen = np.flatnonzero(mask)
+        settings.pixels = chosen.tolist()
         again = _core.render(draws, camera, settings)
-        color[mask] = again["color"][mask]
-        halves[mask] = again["error_map"][mask]
+        color.reshape(-1, color.shape[-1])[chosen] = again["color"].reshape(-1, color.shape[-1])[chosen]
+        halves.reshape(-1)[chosen] = again["error_map"].reshape(-1)[chosen]
         if depth is not None and again["depth"] is not None:
-            depth[mask] = again["depth"][mask]
+            depth.reshape(-1)[chosen] = again["depth"].reshape(-1)[chosen]
         for key, value in again["stats"].items():
             if key != "threads":
                 stats[key] += value
-        spp[mask] = s
+        spp.reshape(-1)[chosen] = s
         settings.samples, settings.pattern, settings.pixels = base, base_pattern, []
     settings.samples, settings.pattern, settings.pixels = base, base_pattern, []
     stats["total_ms"] = (time.perf_counter() - start) * 1000.0  # every pass, every probe, the bookkeeping
-    halves_rmse = float(np.sqrt(np.mean(halves ** 2, dtype=np.float64)))
+    halves_rmse = rms(halves)
     raw["color"], raw["depth"], raw["stats"] = color, depth, stats
     raw["error_estimate"] = measured
     raw["error_map"] = (halves * (measured / halves_rmse if halves_rmse > 0 else 1.0)).astype(np.float32)

@@ -41,7 +41,7 @@ import numpy as np
 from . import _core
 
 __all__ = ["ErrorProbe", "default_pixel_count", "guide", "measure_error", "reference_passes", "reference_scene",
-           "spread"]
+           "rms", "spread"]
 
 REFERENCE_SPP = 64  # _core.MAX_SAMPLES: the most samples one pass gives a pixel
 MIN_PASSES = 2  # independent passes: their disagreement is the reference's own error
@@ -110,6 +110,12 @@ def guide(color: np.ndarray, halves_map: Optional[np.ndarray]) -> np.ndarray:
     return step + spread(m * m)
 
 
+def rms(a: np.ndarray) -> float:
+    """The root mean square of ``a``, summed in double precision."""
+    flat = np.asarray(a).ravel()
+    return math.sqrt(float(np.dot(flat.astype(np.float64), flat)) / flat.size) if flat.size else 0.0
+
+
 def spread(a: np.ndarray) -> np.ndarray:
     """The mean of ``a`` (H, W) over each pixel's 3×3 neighbourhood (zero outside the image)."""
     h, w = a.shape
@@ -149,9 +155,7 @@ def measure_error(scene: Any, camera: Any, settings: Any, color: np.ndarray, hal
     n_all = w * h
     if not (isinstance(pixels, int) and pixels >= 1):
         raise ValueError(f"probe_pixels: expected a number of pixels >= 1, got {pixels!r}")
-    halves_rmse = None
-    if halves_map is not None:
-        halves_rmse = float(math.sqrt(np.mean(np.asarray(halves_map, dtype=np.float64) ** 2)))
+    halves_rmse = None if halves_map is None else rms(halves_map)
     g = (guide(color, halves_map) if guide_map is None else guide_map).astype(np.float64).ravel()
     total = g.sum()
     weight = 0.5 / n_all + 0.5 * g / total if total > 0 else np.full(n_all, 1.0 / n_all)
@@ -178,7 +182,7 @@ def measure_error(scene: Any, camera: Any, settings: Any, color: np.ndarray, hal
     reference = sum(passes) / k_passes
     # E[own] = the reference's squared error (the sample variance of the passes' mean).
     own = (sum((q - reference) ** 2 for q in passes).mean(axis=1)) / (k_passes * (k_passes - 1))
-    diff = np.asarray(color, dtype=np.float64)[ys, xs, :3] - reference
+    diff = np.asarray(color)[ys, xs, :3].astype(np.float64) - reference
     terms = ((diff * diff).mean(axis=1) - own) / (n_all * p[chosen])
     mse = float(terms.mean())
     mse_se = float(terms.std(ddof=1) / math.sqrt(pixels)) if pixels > 1 else math.inf
