@@ -95,11 +95,15 @@ def default_pixel_count(width: int, height: int, spp: int) -> int:
 def guide(color: np.ndarray, halves_map: Optional[np.ndarray]) -> np.ndarray:
     """Where error is likely, (H, W) ≥ 0: the halves map squared, spread over 3×3 neighbourhoods,
     plus the largest squared half colour step (mean over R, G, B) to the 4 neighbours."""
-    c = np.asarray(color)[..., :3]
-    step = np.zeros(c.shape[:2], dtype=np.float32)
-    down, right = c[1:] - c[:-1], c[:, 1:] - c[:, :-1]
-    down = np.einsum("ijk,ijk->ij", down, down) / 12  # mean over R, G, B of (half the step)²
-    right = np.einsum("ijk,ijk->ij", right, right) / 12
+    planes = np.moveaxis(np.asarray(color, dtype=np.float32)[..., :3], 2, 0).copy()  # R, G, B planes
+    step = np.zeros(planes.shape[1:], dtype=np.float32)
+    down = np.zeros((step.shape[0] - 1, step.shape[1]), dtype=np.float32)
+    right = np.zeros((step.shape[0], step.shape[1] - 1), dtype=np.float32)
+    for p in planes:  # mean over R, G, B of (half the step)²
+        d = p[1:] - p[:-1]
+        down += d * d / 12
+        d = p[:, 1:] - p[:, :-1]
+        right += d * d / 12
     np.maximum(step[1:], down, out=step[1:])
     np.maximum(step[:-1], down, out=step[:-1])
     np.maximum(step[:, 1:], right, out=step[:, 1:])
@@ -112,8 +116,8 @@ def guide(color: np.ndarray, halves_map: Optional[np.ndarray]) -> np.ndarray:
 
 def rms(a: np.ndarray) -> float:
     """The root mean square of ``a``, summed in double precision."""
-    flat = np.asarray(a).ravel()
-    return math.sqrt(float(np.dot(flat.astype(np.float64), flat)) / flat.size) if flat.size else 0.0
+    flat = np.asarray(a, dtype=np.float64).ravel()  # (not np.dot: BLAS threads stall on a busy machine)
+    return math.sqrt(float((flat * flat).sum()) / flat.size) if flat.size else 0.0
 
 
 def spread(a: np.ndarray) -> np.ndarray:

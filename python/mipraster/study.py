@@ -274,6 +274,10 @@ def markdown(rows: Sequence[StudyRow], notes: Sequence[str]) -> str:
     ratios = [r for r in rows if not math.isnan(r.estimate_ratio) and r.renderer == "mipraster"]
     if ratios:
         inside = [r for r in ratios if 0.5 <= r.estimate_ratio <= 2.0]
+        # Where the reference's own error is more than half the measured one, the measured RMSE is
+        # mostly the reference's: it cannot judge an estimate of the render's error.
+        judged = [r for r in ratios if r.reference_residual <= 0.5 * r.rmse]
+        judged_inside = [r for r in judged if r in inside]
         worst = max(ratios, key=lambda r: abs(math.log(r.estimate_ratio)) if r.estimate_ratio > 0 else math.inf)
         costs = [r.estimate_ms / r.ms_all_threads for r in ratios
                  if not math.isnan(r.estimate_ms) and r.ms_all_threads > 0]
@@ -281,14 +285,18 @@ def markdown(rows: Sequence[StudyRow], notes: Sequence[str]) -> str:
                 f"estimate / true RMSE within a factor of 2 on {len(inside)} of {len(ratios)} configurations "
                 f"(median ratio {statistics.median(r.estimate_ratio for r in ratios):.2f}, range "
                 f"{min(r.estimate_ratio for r in ratios):.2f}–{max(r.estimate_ratio for r in ratios):.2f}, worst "
-                f"{worst.scene} {worst.label}: {worst.estimate_ratio:.2f}).", ""]
+                f"{worst.scene} {worst.label}: {worst.estimate_ratio:.2f}); on {len(judged_inside)} of the "
+                f"{len(judged)} whose reference's own error is at most half the measured RMSE (the others' "
+                f"measured RMSE is mostly the reference's).", ""]
         if costs:
             out += [f"The probe costs {statistics.median(costs):.2f}× the render's time (median; "
                     f"{min(costs):.2f}–{max(costs):.2f}×, all threads).", ""]
         misses = [r for r in ratios if r not in inside]
         if misses:
             out.append("Outside the factor of 2:")
-            out += [f"- {r.scene} {r.label} ({r.filter}): {r.estimate_ratio:.2f}" for r in misses]
+            out += [f"- {r.scene} {r.label} ({r.filter}): {r.estimate_ratio:.2f}"
+                    + (" (reference residual {:.2g} of RMSE {:.2g})".format(r.reference_residual, r.rmse)
+                       if r not in judged else "") for r in misses]
             out.append("")
     adaptive = [r for r in rows if r.renderer == "mipraster adaptive"]
     if adaptive:
