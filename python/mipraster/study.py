@@ -143,11 +143,8 @@ def _uniform_time_for_error(rows: List[StudyRow], scene: str, error: float) -> O
     return None
 
 
-def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads: int, reference_quality: float,
-                   log) -> List[StudyRow]:
-    t0 = time.perf_counter()
-    ref, residual, kind = s.reference(reference_quality)
-    log(f"  reference: {kind}; its own estimated RMSE {residual:.2e} ({time.perf_counter() - t0:.1f} s)")
+def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads: int, ref: np.ndarray,
+                   residual: float, log) -> List[StudyRow]:
     rows: List[StudyRow] = []
     runs = []
     estimate4 = None
@@ -388,9 +385,11 @@ def study(out_dir: str, scenes: Sequence[str] = tuple(SCENES), scene_files: Sequ
     for s in study_scenes:
         log(f"{s.name}:")
         sweep = tiny_sweep(s.textured) if tiny else default_sweep(s.textured)
-        scene_rows = _measure_scene(s, sweep, repeats, threads, reference_quality, log)
+        t0 = time.perf_counter()
+        ref, residual, kind = s.reference(reference_quality)  # once: llvmpipe's points use it too
+        log(f"  reference: {kind}; its own estimated RMSE {residual:.2e} ({time.perf_counter() - t0:.1f} s)")
+        scene_rows = _measure_scene(s, sweep, repeats, threads, ref, residual, log)
         if llvmpipe and not lp_reason:
-            ref, residual, _ = s.reference(reference_quality)
             try:
                 scene_rows += _llvmpipe_rows(s, ref, residual, repeats, log)
             except Exception as e:  # a driver failure must not lose the measurements made so far
