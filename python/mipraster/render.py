@@ -238,22 +238,19 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
         return render_adaptive_settings(scene, draws, core_camera, settings, target_error, n_probe)
     raw = _core.render(draws, core_camera, settings)
     if estimate and n_probe > 0:
-        calibrate(raw, scene, core_camera, settings, n_probe)
+        _calibrate(raw, scene, core_camera, settings, n_probe)
     return RenderResult(raw)
 
 
-def calibrate(raw: Dict[str, Any], scene: Scene, core_camera: Any, settings: Any, n_probe: int) -> float:
+def _calibrate(raw: Dict[str, Any], scene: Scene, core_camera: Any, settings: Any, n_probe: int) -> None:
     """Measures the error of the core render ``raw`` with a probe of ``n_probe`` pixels (see
     :mod:`mipraster.error_probe`) and puts it into ``raw``: ``error_estimate`` becomes the probe's
-    RMSE and ``error_map`` (when there is one) the halves map scaled to it. Returns the scale
-    (1 when the map is zero everywhere or missing)."""
+    RMSE and ``error_map`` (when there is one and it is not zero everywhere) the halves map scaled
+    to it."""
     from .error_probe import measure_error
 
     probe = measure_error(scene, core_camera, settings, raw["color"], raw.get("error_map"), n_probe,
                           seed=settings.pattern_seed)
     raw["error_probe"], raw["error_estimate"] = probe, probe.rmse
-    scale = 1.0
     if raw.get("error_map") is not None and probe.halves_rmse:
-        scale = probe.rmse / probe.halves_rmse
-        raw["error_map"] = (raw["error_map"] * np.float32(scale)).astype(np.float32)
-    return scale
+        raw["error_map"] = (raw["error_map"] * np.float32(probe.rmse / probe.halves_rmse)).astype(np.float32)
