@@ -178,6 +178,8 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
             row.target_error = target
             row.mean_spp = float(result.pixel_spp.mean())
             row.estimate = result.error_estimate
+            if result.error_probe is not None:
+                row.estimate_stderr = result.error_probe.stderr
         else:
             probed = render(scene, s.camera, s.width, s.height, estimate_error=True, **kwargs)
             row.estimate = probed.error_estimate
