@@ -158,10 +158,11 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             estimated as |A − B|·√(nA·nB)/n; it sees sampling error (edges, texture detail between
             samples), not error that every sample shares (a blurring texture filter, MSAA's one
             shade per pixel), and needs ``spp >= 2``. The probe says how much: ``probe_pixels``
-            pixels, chosen at random (half of them where the map is large), are rendered again
-            at reference quality (64 stratified samples, SSAA, textures read at level 0 with
-            bilinear) and their squared differences give an unbiased estimate of the image's
-            mean squared error, for any scene and any ``spp`` (see :mod:`mipraster.error_probe`).
+            pixels, chosen at random (half of them where edges or the map are large), are
+            rendered again at reference quality (2 or more passes of 64 stratified samples, SSAA,
+            textures read at level 0 with bilinear) and their squared differences (less the
+            reference's own error) give an unbiased estimate of the image's mean squared error,
+            for any scene and any ``spp`` (see :mod:`mipraster.error_probe`).
             ``error_estimate`` is the probe's RMSE, ``error_map`` the halves map scaled to it,
             ``error_probe`` the probe's details (standard error, cost in ms).
         target_error: adaptive quality: render at ``spp`` (at least 2) with the estimate, then
@@ -169,11 +170,13 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             extra pass of just those pixels: the fewest samples that bring the image's estimated
             RMSE to ``target_error`` (an RMSE in linear colour) with error ∝ 1/√spp; repeated
             (at most 4 passes) while the estimate misses the target and some pixel with error
-            has fewer than 64 (see :mod:`mipraster.adaptive`). ``stats['total_ms']`` is the time
-            of all passes and the probe; ``pixel_spp`` shows where samples went.
+            has fewer than 64; each round's error is a new probe of the image (see
+            :mod:`mipraster.adaptive`). ``stats['total_ms']`` is the time of all passes and probes;
+            ``pixel_spp`` shows where samples went. Needs the box resolve.
         probe_pixels: pixels the probe renders again (``estimate_error`` / ``target_error``):
-            None = W·H·spp/256 within [64, 1024] (a quarter of the render's samples), 0 = no probe
-            (the raw halves estimate; needs ``spp >= 2``).
+            None = W·H·spp/(256·K) within [64, 1024] with K reference passes (2, or 4 at 64 spp):
+            a quarter of the render's samples; 0 = no probe (the raw halves estimate; needs
+            ``spp >= 2``).
 
     Returns:
         A :class:`RenderResult`.

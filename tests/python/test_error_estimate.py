@@ -134,7 +134,8 @@ def _dilate(mask, steps):
     out = mask.copy()
     for _ in range(steps):
         grown = np.pad(out, 1)
-        out = np.any([grown[dy:dy + mask.shape[0], dx:dx + mask.shape[1]] for dy in range(3) for dx in range(3)], axis=0)
+        h, w = mask.shape
+        out = np.any([grown[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)], axis=0)
     return out
 
 

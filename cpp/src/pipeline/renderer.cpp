@@ -285,7 +285,8 @@ std::vector<std::vector<PixelSpan>> pixel_spans(const std::vector<std::uint32_t>
     std::sort(sorted.begin(), sorted.end());
     sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
     for (std::uint32_t p : sorted) {  // row-major order: a tile's spans come row by row, left to right
-        const int x = static_cast<int>(p % std::uint32_t(grid.width)), y = static_cast<int>(p / std::uint32_t(grid.width));
+        const int x = static_cast<int>(p % std::uint32_t(grid.width));
+        const int y = static_cast<int>(p / std::uint32_t(grid.width));
         std::vector<PixelSpan>& tile = spans[std::size_t(y / kTileSize) * grid.tiles_x + std::size_t(x / kTileSize)];
         if (!tile.empty() && tile.back().y == y && tile.back().x1 == x) ++tile.back().x1;
         else tile.push_back({y, x, x + 1});
