@@ -145,9 +145,12 @@ TEST(ListedPixels, RenderOnlyThoseExactly) {
         s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
         const std::vector<mr::Draw> draws = {make_draw(m, glm::dmat4(1.0), no_depth())};
         const mr::RenderResult full = mr::render(draws, identity_camera(), s);
-        // Scattered pixels, a run across a tile border, a repeat, the last pixel.
+        // Scattered pixels, a run across a tile border, a repeat, the last pixel, and most of the
+        // first tile (rasterized whole, then resolved only where listed).
         std::vector<bool> wanted(std::size_t(W) * H, false);
         for (std::uint32_t p = 0; p < std::uint32_t(W * H); p += 37) s.pixels.push_back(p);
+        for (int y = 0; y < 26; ++y)
+            for (int x = 0; x < mr::kTileSize; x += (y == 7 ? 2 : 1)) s.pixels.push_back(std::uint32_t(y * W + x));
         for (int x = mr::kTileSize - 3; x < mr::kTileSize + 4; ++x) s.pixels.push_back(std::uint32_t(20 * W + x));
         s.pixels.push_back(s.pixels.front());
         s.pixels.push_back(std::uint32_t(W * H - 1));

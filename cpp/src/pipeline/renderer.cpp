@@ -265,6 +265,12 @@ std::uint64_t render_bytes(const std::vector<Draw>& draws, const RenderSettings&
     return bytes;
 }
 
+// Listed pixels (RenderSettings::pixels) cost about 1.7× a pixel of a whole tile (each span
+// repeats the edge setup of the tile's triangles): from this share of a tile's pixels on, the
+// tile is rasterized whole.
+constexpr double kWholeTileShare = 0.5;
+static_assert(kWholeTileShare > 0.0 && kWholeTileShare <= 1.0, "a share of a tile's pixels");
+
 // One row of listed pixels inside one tile: [x0, x1) × [y, y + 1).
 struct PixelSpan {
     int y, x0, x1;
@@ -441,18 +447,35 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             }
         }
         // The whole tile, or each listed span of it (a span is a thin tile: the kernel clips every
-        // triangle's bounding box to the target's rectangle).
+        // triangle's bounding box to the target's rectangle). Each span repeats the edge setup of
+        // every triangle in the tile, so a tile with at least kWholeTileShare of its pixels listed
+        // is rasterized whole into its tile-local buffer and only the listed spans are resolved
+        // (not with S == 1 or a kept framebuffer, where the samples are the output).
         const PixelSpan whole{target.y0, target.x0, target.x1};
         const PixelSpan* first = listed ? spans[tile].data() : &whole;
         const PixelSpan* last = listed ? first + spans[tile].size() : &whole + 1;
+        int listed_pixels = 0;
+        for (const PixelSpan* span = first; span != last; ++span) listed_pixels += span->x1 - span->x0;
+        const int tile_pixels = (target.x1 - target.x0) * (target.y1 - target.y0);
+        const bool rasterize_whole =
+            !listed || (S > 1 && !whole_frame && listed_pixels >= kWholeTileShare * tile_pixels);
+        if (rasterize_whole) {
+            if (!whole_frame) {  // a kept framebuffer starts cleared
+                target.color.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
+                if (needs_depth) target.depth.fill(target.x0, target.y0, target.x1, target.y1, clear_depth4);
+            }
+            rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
+        }
         for (const PixelSpan* span = first; span != last; ++span) {
             TileTarget part = target;
             if (listed) part.x0 = span->x0, part.x1 = span->x1, part.y0 = span->y, part.y1 = span->y + 1;
-            if (!whole_frame) {  // a kept framebuffer starts cleared
-                part.color.fill(part.x0, part.y0, part.x1, part.y1, settings.clear_color);
-                if (needs_depth) part.depth.fill(part.x0, part.y0, part.x1, part.y1, clear_depth4);
+            if (!rasterize_whole) {
+                if (!whole_frame) {
+                    part.color.fill(part.x0, part.y0, part.x1, part.y1, settings.clear_color);
+                    if (needs_depth) part.depth.fill(part.x0, part.y0, part.x1, part.y1, clear_depth4);
+                }
+                rasterize_tile_chunks(tile, chunks, kernels, inputs, part, tile_counters[tile]);
             }
-            rasterize_tile_chunks(tile, chunks, kernels, inputs, part, tile_counters[tile]);
             if ((settings.keep_samples || S > 1) && !wide_resolve)
                 resolve_tile(part.color, part.x0, part.y0, part.x1, part.y1, settings.resolve_filter, result.color);
             if (settings.estimate_error)
