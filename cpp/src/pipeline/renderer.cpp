@@ -265,7 +265,7 @@ std::uint64_t render_bytes(const std::vector<Draw>& draws, const RenderSettings&
     return bytes;
 }
 
-// Listed pixels (RenderSettings::pixels) cost about 1.7× a pixel of a whole tile (each span
+// Sparse listed pixels (RenderSettings::pixels) cost 1.7–3× a pixel of a whole tile (each span
 // repeats the edge setup of the tile's triangles): from this share of a tile's pixels on, the
 // tile is rasterized whole.
 constexpr double kWholeTileShare = 0.5;
