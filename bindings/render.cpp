@@ -196,6 +196,9 @@ void bind_render(py::module_& m) {
                        "estimate the error from two interleaved halves of the samples (needs samples >= 2)")
         .def_readwrite("tile_mask", &RenderSettings::tile_mask,
                        "[] = every tile; else one flag per TILE_SIZE^2 tile, row-major: only flagged tiles render")
+        .def_readwrite("pixels", &RenderSettings::pixels,
+                       "[] = every pixel; else the indices y * width + x of the only pixels to render (one setup; "
+                       "the others keep the clear colour)")
         .def("__repr__", &RenderSettings::to_string);
 
     py::class_<RasterizeSettings>(m, "RasterizeSettings", "Image size, sampling, depth convention and culling of rasterize().")

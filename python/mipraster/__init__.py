@@ -40,7 +40,8 @@ case (also ``mipraster stress`` on the command line).
 Catmull–Rom, Lanczos-3; widened when shrinking, in linear colour) and :func:`synthesize` grows a new
 texture from a sample (Efros & Leung), ready to use as a :class:`Texture`.
 :func:`render` can estimate its own error (``estimate_error=True``: ``result.error_map``,
-``result.error_estimate``) and spend samples adaptively (``target_error=e``). The error-against-time
+``result.error_estimate``, measured on a sparse reference by :mod:`mipraster.error_probe`) and spend
+samples adaptively, pixel by pixel (``target_error=e``, :mod:`mipraster.adaptive`). The error-against-time
 study is :func:`mipraster.study.study` (``python -m mipraster.study``, ``mipraster study``); its
 ground truths are in :mod:`mipraster.reference` and its scenes in :mod:`mipraster.study_scenes`.
 

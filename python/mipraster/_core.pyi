@@ -184,6 +184,9 @@ class RenderSettings:
     resolve_filter: str
     estimate_error: bool
     tile_mask: List[int]
+    pixels: List[int]
+    """[] = every pixel; else the indices y * width + x of the only pixels to render (one transform
+    and setup; each row of listed pixels in a tile is one span); the others keep the clear colour."""
     def __init__(self) -> None: ...
     @property
     def clear_color(self) -> _RGBA: ...

@@ -1,105 +1,141 @@
-"""Adaptive quality: more samples only on the tiles whose estimated error needs them.
+"""Adaptive quality: more samples only for the pixels whose estimated error needs them.
 
-A first pass renders every tile at the requested samples per pixel S₀ with the error estimate on
-(two interleaved halves of each pixel's samples; see :func:`mipraster.render`). With error ∝ 1/√S,
-tile t's variance v_t = e_t²·S_t is known, and the fewest samples that bring the image's estimated
-RMSE to the target T are S'_t = √v_t·Σ_u √v_u / (N·T²) (minimize Σ S'_t subject to
-Σ v_t/S'_t ≤ N·T², N tiles). Each tile that needs more than it has is rendered again with S'_t
-rounded up to S₀·2^k (at most 64); tiles that need the same count share one pass (the renderer's
-tile mask skips all others). The estimate is measured again and the rounds go on until the image's
-estimate meets the target or every tile with any error has 64 samples. Tiles with no estimated error
-(nothing but flat colour) are never rendered again.
+A first pass renders the image at the requested samples per pixel S₀ with the halves map on, and
+the probe (:mod:`mipraster.error_probe`) measures the image's error E. The per-pixel estimate is the
+probe's guide (the halves map squared and spread over 3×3 neighbourhoods, plus the squared colour
+step to the neighbours: error the halves miss at few samples) scaled so that its root mean square
+is E. With error ∝
+1/√S, raising pixel i from s_i to S samples lowers its squared error e_i² by e_i²·(1 − s_i/S). For
+each candidate count S (S₀·2^k, up to 64) the pixels with the largest gains are taken until the
+image's predicted mean squared error meets the target T²; the candidate with the fewest new samples
+(pixels × S) wins, and only those pixels are rendered again, in one pass of the C++ renderer
+(``RenderSettings.pixels``: one transform and setup, each row of chosen pixels in a tile one span).
+Their colour and halves replace the first pass's, and the probe measures the new image. The rounds
+go on (at most ``MAX_PASSES`` refinement passes) while the measured error misses the target and some
+pixel with estimated error has fewer than 64 samples. The error reported is always the probe's
+measurement of the returned image. Pixels with no estimated error nearby (flat colour) are never
+rendered again.
 """
 from __future__ import annotations
 
 import math
-from typing import Any, List
+import time
+from typing import Any, List, Optional, Tuple
 
 import numpy as np
 
 from . import _checks, _core
 
-__all__ = ["tile_rmse", "render_adaptive_settings"]
+__all__ = ["plan_refinement", "render_adaptive_settings", "MAX_PASSES"]
+
+MAX_PASSES = 4  # refinement passes after the first; each repeats the scene's setup once
 
 
+def plan_refinement(error: np.ndarray, spp: np.ndarray, target: float, base: int) -> Optional[Tuple[np.ndarray, int]]:
+    """The pixels to render again and their new sample count: ``(mask, S)`` with the fewest new
+    samples that bring the root mean square of ``error`` (per pixel, with ``spp`` samples each) to
+    ``target`` under error ∝ 1/√spp, or, when no candidate S reaches it, every pixel with error at
+    64. None when no pixel with error can get more samples."""
+    e2 = np.asarray(error, dtype=np.float64) ** 2
+    need = e2.sum() - target * target * e2.size  # the squared error to remove, summed over pixels
+    some = np.flatnonzero(e2 > 0)  # only pixels with error can gain
+    e2_some, spp_some = e2.ravel()[some], np.asarray(spp).ravel()[some]
+    candidates = sorted({base * 2 ** k for k in range(1, 7) if base * 2 ** k <= _core.MAX_SAMPLES}
+                        | {_core.MAX_SAMPLES})
+    # With equal sample counts every candidate ranks the pixels alike: sort once.
+    uniform = np.argsort(-e2_some, kind="stable") if np.all(spp_some == spp_some[:1]) else None
+    best = None
+    for s in candidates:
+        eligible = spp_some < s
+        if not eligible.any():
+            continue
+        gain = np.where(eligible, e2_some * (1.0 - spp_some / s), 0.0)
+        # Largest gain first; ties in pixel order.
+        order = uniform if uniform is not None else np.argsort(-gain, kind="stable")
+        k = int(np.searchsorted(np.cumsum(gain[order]), need * (1 - 1e-12))) + 1
+        if k > int(eligible.sum()):
+            continue  # this count cannot reach the target
+        if best is None or k * s < best[0]:
+            best = (k * s, some[order[:k]], s)
+    mask = np.zeros(e2.size, dtype=bool)
+    if best is not None:
+        mask[best[1]] = True
+        return mask.reshape(e2.shape), best[2]
+    mask[some[spp_some < _core.MAX_SAMPLES]] = True
+    return (mask.reshape(e2.shape), _core.MAX_SAMPLES) if mask.any() else None
 
-def tile_rmse(error_map: np.ndarray, tile: int = _core.TILE_SIZE) -> np.ndarray:
-    """Root mean square of ``error_map`` (H, W) over each ``tile``×``tile`` block, as (tiles_y, tiles_x)."""
-    h, w = error_map.shape
-    ty, tx = -(-h // tile), -(-w // tile)
-    padded = np.zeros((ty * tile, tx * tile), dtype=np.float64)
-    counts = np.zeros_like(padded)
-    padded[:h, :w] = np.asarray(error_map, dtype=np.float64) ** 2
-    counts[:h, :w] = 1.0
-    sums = padded.reshape(ty, tile, tx, tile).sum(axis=(1, 3))
-    n = counts.reshape(ty, tile, tx, tile).sum(axis=(1, 3))
-    return np.sqrt(sums / n)
 
+def render_adaptive_settings(scene: Any, draws: List[Any], camera: Any, settings: Any, target_error: Any,
+                             probe_pixels: int) -> Any:
+    """Adaptive render of already checked core draws / camera / settings of ``scene``
+    (``mipraster.render`` calls this).
 
-def render_adaptive_settings(draws: List[Any], camera: Any, settings: Any, target_error: Any) -> Any:
-    """Adaptive render of already checked core draws / camera / settings (``mipraster.render`` calls this).
-
-    Raises ValueError for a target that is not a finite number > 0 or with ``keep_samples``.
+    Raises ValueError for a target that is not a finite number > 0, with ``keep_samples`` or with
+    a resolve filter other than box.
     """
+    from .error_probe import guide, measure_error, rms
     from .render import RenderResult
 
     target = _checks.real(target_error, "target_error")
     if not (math.isfinite(target) and target > 0.0):
         raise ValueError(f"target_error: expected a finite RMSE > 0 (linear colour), got {target!r}")
     if settings.keep_samples:
-        raise ValueError("target_error: cannot keep the samples of an adaptive render (tiles differ in samples per pixel)")
+        raise ValueError("target_error: cannot keep the samples of an adaptive render (pixels differ in samples)")
+    if settings.resolve_filter != "box":
+        raise ValueError(f"target_error: adaptive quality re-renders single pixels and needs the box resolve, "
+                         f"got resolve_filter={settings.resolve_filter!r}")
+    start = time.perf_counter()
     settings.estimate_error = True
-    settings.tile_mask = []
     raw = _core.render(draws, camera, settings)
-    color, error_map, depth = raw["color"], raw["error_map"], raw["depth"]
+    color, depth = raw["color"], raw["depth"]
+    halves = raw["error_map"]  # float32
     stats = dict(raw["stats"])
-    tile = _core.TILE_SIZE
-    per_tile = tile_rmse(error_map, tile)
     base = settings.samples
-    tile_spp = np.full(per_tile.shape, base, dtype=np.int64)
-    count = np.ones_like(per_tile)  # pixels per tile, for the image's mean
-    count[:] = np.bincount((np.arange(color.shape[0])[:, None] // tile * per_tile.shape[1]
-                            + np.arange(color.shape[1])[None, :] // tile).ravel(),
-                           minlength=per_tile.size).reshape(per_tile.shape)
-    while True:
-        image_mse = float((per_tile ** 2 * count).sum() / count.sum())
-        open_tiles = (per_tile > 0) & (tile_spp < _core.MAX_SAMPLES)
-        if image_mse <= target * target or not open_tiles.any():
+    spp = np.full(halves.shape, base, dtype=np.int64)
+    base_pattern = settings.pattern
+    probe = None
+    likely = None
+    for passes in range(MAX_PASSES + 1):
+        # The probe may choose its pixels by any guide that is not the reference's: the latest
+        # guide, but only computed again when a pass is to be planned on it.
+        if likely is None:
+            likely = guide(color, halves)
+        if probe_pixels > 0:
+            probe = measure_error(scene, camera, settings, color, halves, probe_pixels, seed=settings.pattern_seed,
+                                  guide_map=likely)
+            measured = probe.rmse
+        else:
+            measured = rms(halves)
+        if measured <= target or passes == MAX_PASSES or not likely.any():
             break
-        # The optimal allocation for the image's mean squared error (see the module docstring).
-        sd = per_tile * np.sqrt(tile_spp) * np.sqrt(count)
-        need = sd / np.sqrt(count) * sd.sum() / (count.sum() * target * target)
-        steps = np.ceil(np.log2(np.maximum(need / base, 1.0)) - 1e-9).astype(np.int64)
-        wanted = np.minimum(_core.MAX_SAMPLES, base * 2 ** np.minimum(steps, 6))
-        wanted = np.where(open_tiles & (wanted > tile_spp), wanted, tile_spp)
-        if (wanted == tile_spp).all():
-            # The estimate is just above the target and rounding left nothing to do: double the
-            # samples of every open tile that holds more than its share of the squared error.
-            share = np.where(open_tiles, per_tile ** 2 * count, 0.0)
-            big = open_tiles & (share >= share[open_tiles].mean())
-            wanted = np.where(big, np.minimum(_core.MAX_SAMPLES, 2 * tile_spp), tile_spp)
-        todo = wanted > tile_spp
+        if passes > 0:
+            likely = guide(color, halves)
+        error = np.sqrt(likely * np.float32(measured * measured / likely.mean(dtype=np.float64)))  # RMS: measured
+        plan = plan_refinement(error, spp, target, base)
+        if plan is None:
+            break
+        mask, s = plan
+        settings.samples = s
         if settings.pattern == _core.PatternKind.rotated:
             settings.pattern = _core.PatternKind.grid  # the rotated pattern has 4 samples only
-        for spp in sorted(set(wanted[todo].tolist())):
-            group = todo & (wanted == spp)
-            settings.samples = int(spp)
-            settings.tile_mask = group.astype(np.uint8).ravel().tolist()
-            again = _core.render(draws, camera, settings)
-            for ty, tx in zip(*np.nonzero(group)):
-                rows = slice(ty * tile, (ty + 1) * tile)
-                cols = slice(tx * tile, (tx + 1) * tile)
-                color[rows, cols] = again["color"][rows, cols]
-                error_map[rows, cols] = again["error_map"][rows, cols]
-                if depth is not None and again["depth"] is not None:
-                    depth[rows, cols] = again["depth"][rows, cols]
-            for key, value in again["stats"].items():
-                if key != "threads":
-                    stats[key] += value
-            tile_spp[group] = spp
-        per_tile = np.where(todo, tile_rmse(error_map, tile), per_tile)
-    settings.samples = base
-    raw["color"], raw["error_map"], raw["depth"], raw["stats"] = color, error_map, depth, stats
-    raw["error_estimate"] = float(np.sqrt(np.mean(np.asarray(error_map, dtype=np.float64) ** 2)))
-    raw["tile_spp"] = tile_spp
+        chosen = np.flatnonzero(mask)
+        settings.pixels = chosen.tolist()
+        again = _core.render(draws, camera, settings)
+        color.reshape(-1, color.shape[-1])[chosen] = again["color"].reshape(-1, color.shape[-1])[chosen]
+        halves.reshape(-1)[chosen] = again["error_map"].reshape(-1)[chosen]
+        if depth is not None and again["depth"] is not None:
+            depth.reshape(-1)[chosen] = again["depth"].reshape(-1)[chosen]
+        for key, value in again["stats"].items():
+            if key != "threads":
+                stats[key] += value
+        spp.reshape(-1)[chosen] = s
+        settings.samples, settings.pattern, settings.pixels = base, base_pattern, []
+    settings.samples, settings.pattern, settings.pixels = base, base_pattern, []
+    stats["total_ms"] = (time.perf_counter() - start) * 1000.0  # every pass, every probe, the bookkeeping
+    halves_rmse = rms(halves)
+    raw["color"], raw["depth"], raw["stats"] = color, depth, stats
+    raw["error_estimate"] = measured
+    raw["error_map"] = (halves * (measured / halves_rmse if halves_rmse > 0 else 1.0)).astype(np.float32)
+    raw["error_probe"] = probe
+    raw["pixel_spp"] = spp
     return RenderResult(raw)

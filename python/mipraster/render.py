@@ -45,11 +45,14 @@ class RenderResult:
         pattern_kind: the pattern used (``"center"``, ``"grid"``, ``"rotated"`` or ``"stratified"``).
         error_map: ``(H, W)`` float32 per-pixel error estimate (root mean square over R, G, B of the
             linear colour) when the render was asked for one (``estimate_error=True`` or
-            ``target_error``), else None. It comes from the disagreement of two interleaved halves
-            of each pixel's samples (see :func:`render`).
+            ``target_error``) with 2 or more samples per pixel, else None. It comes from the
+            disagreement of two interleaved halves of each pixel's samples, scaled so that its
+            root mean square is :attr:`error_estimate` (see :func:`render`).
         error_estimate: the estimated RMSE of the whole image (linear R, G, B), or None.
-        tile_spp: ``(tiles_y, tiles_x)`` int array of the samples per pixel each 32×32 tile got, for
-            an adaptive render (``target_error``), else None.
+        error_probe: the :class:`mipraster.error_probe.ErrorProbe` (the sparse reference's
+            measurement, its standard error and its cost), or None.
+        pixel_spp: ``(H, W)`` int array of the samples each pixel got, for an adaptive render
+            (``target_error``), else None.
         stats: dict of the renderer's counters (``triangles_in``, ``triangles_clipped``,
             ``triangles_outside``, ``triangles_backface``, ``triangles_degenerate``,
             ``triangles_nonfinite``, ``triangles_rasterized``, ``samples_covered``,
@@ -58,7 +61,7 @@ class RenderResult:
     """
 
     __slots__ = ("color", "depth", "samples", "sample_depth", "pattern", "pattern_kind", "stats", "error_map",
-                 "error_estimate", "tile_spp")
+                 "error_estimate", "error_probe", "pixel_spp")
 
     def __init__(self, raw: Dict[str, Any]) -> None:
         self.color: np.ndarray = raw["color"]
@@ -71,7 +74,8 @@ class RenderResult:
         self.error_map: Optional[np.ndarray] = raw.get("error_map")
         estimate = raw.get("error_estimate")
         self.error_estimate: Optional[float] = None if estimate is None else float(estimate)
-        self.tile_spp: Optional[np.ndarray] = raw.get("tile_spp")
+        self.error_probe: Optional[Any] = raw.get("error_probe")
+        self.pixel_spp: Optional[np.ndarray] = raw.get("pixel_spp")
 
     @property
     def width(self) -> int:
@@ -120,7 +124,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
            pattern: str = "auto", seed: int = 0, threads: int = 0, clear_color: Any = None,
            keep_samples: bool = False, depth: bool = True, derivatives: str = "analytic",
            debug_view: str = "none", resolve_filter: str = "box", estimate_error: bool = False,
-           target_error: Optional[float] = None) -> RenderResult:
+           target_error: Optional[float] = None, probe_pixels: Optional[int] = None) -> RenderResult:
     """Renders ``scene`` through ``camera`` into a ``width`` × ``height`` image.
 
     Args:
@@ -148,19 +152,31 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             ``"catmull-rom"``, ``"lanczos3"``; radius in pixels) that weighs the samples of the
             pixels around it too: for a grid pattern, the same as resampling the image of the
             samples to the output size with that filter. One sample per pixel runs no resolve.
-        estimate_error: also estimate the render's error without a reference: each pixel's samples
-            are split into two interleaved halves A and B (a checkerboard over the pattern's
-            strata) and the full resolve's error is estimated as |A − B|·√(nA·nB)/n, exact in
-            expectation when the samples' errors are independent. It sees sampling error (edges,
-            texture detail between samples), not error that every sample shares (a blurring
-            texture filter; MSAA's one shade per pixel). Needs ``spp >= 2``. Fills
-            ``error_map`` and ``error_estimate``.
-        target_error: adaptive quality: render at ``spp`` (at least 2), then re-render the 32×32
-            tiles whose estimated error needs it with the samples the estimate says they need
-            (error ∝ 1/√spp; the fewest samples for the image's estimated RMSE), up to 64, until
-            the image's estimate meets ``target_error`` (an RMSE in linear colour) or every tile
-            with any error has 64 (see :mod:`mipraster.adaptive`).
-            ``stats['total_ms']`` is the time of all passes; ``tile_spp`` shows where samples went.
+        estimate_error: also estimate the render's error without a reference, in two parts. The
+            halves map says where: each pixel's samples are split into two interleaved halves A
+            and B (a checkerboard over the pattern's strata) and the full resolve's error is
+            estimated as |A − B|·√(nA·nB)/n; it sees sampling error (edges, texture detail between
+            samples), not error that every sample shares (a blurring texture filter, MSAA's one
+            shade per pixel), and needs ``spp >= 2``. The probe says how much: ``probe_pixels``
+            pixels, chosen at random (half of them where edges or the map are large), are
+            rendered again at reference quality (2 or more passes of 64 stratified samples, SSAA,
+            textures read at level 0 with bilinear) and their squared differences (less the
+            reference's own error) give an unbiased estimate of the image's mean squared error,
+            for any scene and any ``spp`` (see :mod:`mipraster.error_probe`).
+            ``error_estimate`` is the probe's RMSE, ``error_map`` the halves map scaled to it,
+            ``error_probe`` the probe's details (standard error, cost in ms).
+        target_error: adaptive quality: render at ``spp`` (at least 2) with the estimate, then
+            give more samples (up to 64) to the pixels whose estimated error needs them, in one
+            extra pass of just those pixels: the fewest samples that bring the image's estimated
+            RMSE to ``target_error`` (an RMSE in linear colour) with error ∝ 1/√spp; repeated
+            (at most 4 passes) while the estimate misses the target and some pixel with error
+            has fewer than 64; each round's error is a new probe of the image (see
+            :mod:`mipraster.adaptive`). ``stats['total_ms']`` is the time of all passes and probes;
+            ``pixel_spp`` shows where samples went. Needs the box resolve.
+        probe_pixels: pixels the probe renders again (``estimate_error`` / ``target_error``):
+            None = W·H·spp/(256·K) within [64, 1024] with K reference passes (2, or 4 at 64 spp):
+            a quarter of the render's samples; 0 = no probe (the raw halves estimate; needs
+            ``spp >= 2``).
 
     Returns:
         A :class:`RenderResult`.
@@ -189,9 +205,15 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     debug = _checks.choice(debug_view, "debug_view", DEBUG_VIEWS)
     resolve = _checks.choice(resolve_filter, "resolve_filter", {f: f for f in RESAMPLE_FILTERS})
     estimate = _checks.flag(estimate_error, "estimate_error")
-    if (estimate or target_error is not None) and samples == 1:
-        raise ValueError("estimate_error / target_error: the error estimate compares two halves of each "
-                         "pixel's samples; give spp >= 2")
+    if probe_pixels is None:
+        n_probe = None
+    else:
+        n_probe = _int_in(probe_pixels, "probe_pixels", 0, 2**31 - 1, "0 (no probe) or a number of pixels")
+    if target_error is not None and samples == 1:
+        raise ValueError("target_error: adaptive quality needs the halves map of each pixel's samples; give spp >= 2")
+    if estimate and samples == 1 and n_probe == 0:
+        raise ValueError("estimate_error: without a probe (probe_pixels=0) the error estimate compares two halves "
+                         "of each pixel's samples; give spp >= 2")
     if clear_color is None:
         clear_color = scene.clear_color if scene.clear_color is not None else (0.0, 0.0, 0.0, 0.0)
     clear = _checks.rgba(clear_color, "clear_color")
@@ -208,9 +230,30 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     settings.depth_output = depth_output
     settings.derivatives, settings.debug_view = derivative_mode, debug
     settings.resolve_filter = resolve
-    settings.estimate_error = estimate or target_error is not None
+    settings.estimate_error = (estimate or target_error is not None) and samples >= 2
+    if n_probe is None:
+        from .error_probe import default_pixel_count
+
+        n_probe = default_pixel_count(w, h, samples)
     if target_error is not None:
         from .adaptive import render_adaptive_settings
 
-        return render_adaptive_settings(draws, core_camera, settings, target_error)
-    return RenderResult(_core.render(draws, core_camera, settings))
+        return render_adaptive_settings(scene, draws, core_camera, settings, target_error, n_probe)
+    raw = _core.render(draws, core_camera, settings)
+    if estimate and n_probe > 0:
+        _calibrate(raw, scene, core_camera, settings, n_probe)
+    return RenderResult(raw)
+
+
+def _calibrate(raw: Dict[str, Any], scene: Scene, core_camera: Any, settings: Any, n_probe: int) -> None:
+    """Measures the error of the core render ``raw`` with a probe of ``n_probe`` pixels (see
+    :mod:`mipraster.error_probe`) and puts it into ``raw``: ``error_estimate`` becomes the probe's
+    RMSE and ``error_map`` (when there is one and it is not zero everywhere) the halves map scaled
+    to it."""
+    from .error_probe import measure_error
+
+    probe = measure_error(scene, core_camera, settings, raw["color"], raw.get("error_map"), n_probe,
+                          seed=settings.pattern_seed)
+    raw["error_probe"], raw["error_estimate"] = probe, probe.rmse
+    if raw.get("error_map") is not None and probe.halves_rmse:
+        raw["error_map"] = (raw["error_map"] * np.float32(probe.rmse / probe.halves_rmse)).astype(np.float32)

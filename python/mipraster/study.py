@@ -6,8 +6,9 @@ files given) with a sweep of samples per pixel, sample patterns, SSAA / MSAA, te
 anisotropy and LOD bias, plus adaptive renders (``render(..., target_error=e)``). For each
 configuration it records the median wall time of ``repeats`` renders with one thread and with all
 threads, and the error against the scene's reference (RMSE, mean and max absolute error over linear
-R, G, B). For every configuration with 2 or more samples per pixel it also records the renderer's
-own error estimate (``estimate_error=True``) and its ratio to the true RMSE. Where moderngl can
+R, G, B). For every configuration it also records the renderer's own error estimate
+(``estimate_error=True``: the halves map calibrated by a sparse reference, see
+:mod:`mipraster.error_probe`), its standard error, its cost and its ratio to the true RMSE. Where moderngl can
 open an EGL context on Mesa's llvmpipe, llvmpipe's 1x / MSAA 4x / SSAA 4x renders of the same
 scenes join as comparison points; where it cannot, the study says why and goes on.
 
@@ -86,6 +87,8 @@ class StudyRow:
     reference_residual: float
     estimate: float = float("nan")
     estimate_ratio: float = float("nan")
+    estimate_stderr: float = float("nan")  # the probe's standard error
+    estimate_ms: float = float("nan")  # the probe's cost (all threads), next to ms_all_threads
     target_error: float = float("nan")
     mean_spp: float = float("nan")
     notes: str = ""
@@ -140,11 +143,8 @@ def _uniform_time_for_error(rows: List[StudyRow], scene: str, error: float) -> O
     return None
 
 
-def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads: int, reference_quality: float,
-                   log) -> List[StudyRow]:
-    t0 = time.perf_counter()
-    ref, residual, kind = s.reference(reference_quality)
-    log(f"  reference: {kind}; its own estimated RMSE {residual:.2e} ({time.perf_counter() - t0:.1f} s)")
+def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads: int, ref: np.ndarray,
+                   residual: float, log) -> List[StudyRow]:
     rows: List[StudyRow] = []
     runs = []
     estimate4 = None
@@ -176,11 +176,14 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
                        reference_residual=residual, **err)
         if target is not None:
             row.target_error = target
-            counts = result.tile_spp.astype(float)
-            row.mean_spp = float(counts.mean())
+            row.mean_spp = float(result.pixel_spp.mean())
             row.estimate = result.error_estimate
-        elif k.spp >= 2:
-            row.estimate = render(scene, s.camera, s.width, s.height, estimate_error=True, **kwargs).error_estimate
+            if result.error_probe is not None:
+                row.estimate_stderr = result.error_probe.stderr
+        else:
+            probed = render(scene, s.camera, s.width, s.height, estimate_error=True, **kwargs)
+            row.estimate = probed.error_estimate
+            row.estimate_stderr, row.estimate_ms = probed.error_probe.stderr, probed.error_probe.ms
         if not math.isnan(row.estimate) and row.rmse > 0:
             row.estimate_ratio = row.estimate / row.rmse
         rows.append(row)
@@ -263,19 +266,36 @@ def markdown(rows: Sequence[StudyRow], notes: Sequence[str]) -> str:
         for i, r in enumerate(rs):
             label = r.label + (f" (mean {r.mean_spp:.1f} spp)" if not math.isnan(r.mean_spp) else "")
             out.append(f"| {label} | {r.filter} | {r.ms_one_thread:.2f} | {r.ms_all_threads:.2f} | {r.rmse:.4g} | "
-                       f"{r.mean_abs:.4g} | {r.max_abs:.3g} | {_fmt(r.estimate)} | {_fmt(r.estimate_ratio, 2)} | "
+                       f"{r.mean_abs:.4g} | {r.max_abs:.3g} | {_fmt(r.estimate)} ± {_fmt(r.estimate_stderr, 2)} | "
+                       f"{_fmt(r.estimate_ratio, 2)} | "
                        f"{'●' if i in front else ''} |")
         out.append("")
     ratios = [r for r in rows if not math.isnan(r.estimate_ratio) and r.renderer == "mipraster"]
     if ratios:
         inside = [r for r in ratios if 0.5 <= r.estimate_ratio <= 2.0]
+        # Where the reference's own error is more than half the measured one, the measured RMSE is
+        # mostly the reference's: it cannot judge an estimate of the render's error.
+        judged = [r for r in ratios if r.reference_residual <= 0.5 * r.rmse]
+        judged_inside = [r for r in judged if r in inside]
+        worst = max(ratios, key=lambda r: abs(math.log(r.estimate_ratio)) if r.estimate_ratio > 0 else math.inf)
+        costs = [r.estimate_ms / r.ms_all_threads for r in ratios
+                 if not math.isnan(r.estimate_ms) and r.ms_all_threads > 0]
         out += ["## Error estimate calibration", "",
                 f"estimate / true RMSE within a factor of 2 on {len(inside)} of {len(ratios)} configurations "
-                f"(median ratio {statistics.median(r.estimate_ratio for r in ratios):.2f}).", ""]
+                f"(median ratio {statistics.median(r.estimate_ratio for r in ratios):.2f}, range "
+                f"{min(r.estimate_ratio for r in ratios):.2f}–{max(r.estimate_ratio for r in ratios):.2f}, worst "
+                f"{worst.scene} {worst.label}: {worst.estimate_ratio:.2f}); on {len(judged_inside)} of the "
+                f"{len(judged)} whose reference's own error is at most half the measured RMSE (the others' "
+                f"measured RMSE is mostly the reference's).", ""]
+        if costs:
+            out += [f"The probe costs {statistics.median(costs):.2f}× the render's time (median; "
+                    f"{min(costs):.2f}–{max(costs):.2f}×, all threads).", ""]
         misses = [r for r in ratios if r not in inside]
         if misses:
             out.append("Outside the factor of 2:")
-            out += [f"- {r.scene} {r.label} ({r.filter}): {r.estimate_ratio:.2f}" for r in misses]
+            out += [f"- {r.scene} {r.label} ({r.filter}): {r.estimate_ratio:.2f}"
+                    + (" (reference residual {:.2g} of RMSE {:.2g})".format(r.reference_residual, r.rmse)
+                       if r not in judged else "") for r in misses]
             out.append("")
     adaptive = [r for r in rows if r.renderer == "mipraster adaptive"]
     if adaptive:
@@ -367,9 +387,11 @@ def study(out_dir: str, scenes: Sequence[str] = tuple(SCENES), scene_files: Sequ
     for s in study_scenes:
         log(f"{s.name}:")
         sweep = tiny_sweep(s.textured) if tiny else default_sweep(s.textured)
-        scene_rows = _measure_scene(s, sweep, repeats, threads, reference_quality, log)
+        t0 = time.perf_counter()
+        ref, residual, kind = s.reference(reference_quality)  # once: llvmpipe's points use it too
+        log(f"  reference: {kind}; its own estimated RMSE {residual:.2e} ({time.perf_counter() - t0:.1f} s)")
+        scene_rows = _measure_scene(s, sweep, repeats, threads, ref, residual, log)
         if llvmpipe and not lp_reason:
-            ref, residual, _ = s.reference(reference_quality)
             try:
                 scene_rows += _llvmpipe_rows(s, ref, residual, repeats, log)
             except Exception as e:  # a driver failure must not lose the measurements made so far

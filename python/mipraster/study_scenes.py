@@ -3,6 +3,8 @@
 - ``star``: a fan of thin triangles (a star) with two thin bars across it, flat colours, seen
   through an orthographic camera that maps world (x, −y) to pixel (x, y): edge aliasing. Its
   reference is the exact coverage (:func:`mipraster.reference.exact_coverage`).
+- ``shapes``: five large flat-coloured triangles, overlapping, same camera and reference: wide flat
+  regions and a few long edges (where per-pixel adaptive sampling can pay).
 - ``checker_plane``: a checker-textured floor running to the horizon: texture minification and
   anisotropy, edge aliasing along the horizon. Reference: :func:`mipraster.reference.plane_reference`.
 - ``zone_plate``: a zone plate cos(π r²/w) texture (its frequency rises to the Nyquist limit of the
@@ -25,7 +27,7 @@ from .reference import PerspectiveView, TexturedPlane, converged_reference, exac
 from .scene import Scene
 from .texture import Sampler, Texture
 
-__all__ = ["StudyScene", "star", "checker_plane", "zone_plate", "from_file", "with_filter", "SCENES"]
+__all__ = ["StudyScene", "star", "shapes", "checker_plane", "zone_plate", "from_file", "with_filter", "SCENES"]
 
 
 @dataclass
@@ -108,6 +110,33 @@ def star(width: int = 160, height: int = 120, spikes: int = 24) -> StudyScene:
     return StudyScene("star", scene, _pixel_camera(width, height), width, height, clear, reference)
 
 
+def shapes(width: int = 160, height: int = 120) -> StudyScene:
+    """A few large flat-coloured triangles, some overlapping, over a background: wide flat regions
+    that one sample per pixel renders exactly and a few long edges that need many (where per-pixel
+    adaptive sampling can save time)."""
+    corners = [  # in fractions of the image, drawn in this order
+        [(0.08, 0.12), (0.55, 0.05), (0.30, 0.62)],
+        [(0.60, 0.18), (0.96, 0.47), (0.50, 0.90)],
+        [(0.05, 0.72), (0.47, 0.55), (0.33, 0.96)],
+        [(0.22, 0.30), (0.83, 0.37), (0.44, 0.52)],
+        [(0.70, 0.60), (0.93, 0.93), (0.62, 0.97)],
+    ]
+    colours = np.array([(0.9, 0.3, 0.1), (0.1, 0.5, 0.9), (0.2, 0.8, 0.3), (0.95, 0.85, 0.2), (0.8, 0.2, 0.7)])
+    tri_xy = np.array(corners, dtype=np.float64) * [width, height]
+    positions = np.concatenate([tri_xy[..., 0:1], -tri_xy[..., 1:2], np.zeros(tri_xy.shape[:2] + (1,))], axis=2)
+    mesh = Mesh(positions.reshape(-1, 3), np.arange(3 * len(corners)).reshape(-1, 3),
+                colors=np.repeat(colours, 3, axis=0))
+    scene = Scene()
+    scene.add(mesh, depth_test=False, interpolation="flat")
+    clear = (0.02, 0.02, 0.05, 1.0)
+    scene.clear_color = clear
+
+    def reference(quality: float = 1.0) -> Tuple[np.ndarray, float, str]:
+        return exact_coverage(tri_xy, colours, width, height, clear[:3]), 0.0, "exact coverage"
+
+    return StudyScene("shapes", scene, _pixel_camera(width, height), width, height, clear, reference)
+
+
 def _plane_scene(name: str, plane: TexturedPlane, view: PerspectiveView, sampler: Sampler, width: int, height: int,
                  clear: Tuple[float, float, float, float]) -> StudyScene:
     o, ea, eb = (np.asarray(v, dtype=np.float64) for v in (plane.origin, plane.edge_a, plane.edge_b))
@@ -181,4 +210,4 @@ def from_file(path: str, width: int = 160, height: int = 120) -> StudyScene:
     return StudyScene(name, scene, camera, width, height, clear, reference)
 
 
-SCENES = {"star": star, "checker_plane": checker_plane, "zone_plate": zone_plate}
+SCENES = {"star": star, "shapes": shapes, "checker_plane": checker_plane, "zone_plate": zone_plate}

@@ -2,7 +2,8 @@
 // the halves are a checkerboard over the pattern's strata; the estimate of a pixel whose halves
 // disagree by d is d·√(nA·nB)/n (d/2 for equal halves), zero where they agree; the estimate the
 // renderer returns equals the one computed from its kept samples; a masked render leaves the
-// other tiles at the clear colour and renders the flagged ones exactly as a full render does.
+// other tiles at the clear colour and renders the flagged ones exactly as a full render does; a
+// render of listed pixels renders those (colour, depth, estimate) exactly as a full render does.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -131,6 +132,67 @@ TEST(TileMask, RendersOnlyFlaggedTilesExactly) {
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("tile_mask: expected 6 flags"), std::string::npos) << e.what();
     }
+}
+
+TEST(ListedPixels, RenderOnlyThoseExactly) {
+    const mr::Mesh m = slanted_triangle();
+    const int W = 2 * mr::kTileSize + 5, H = mr::kTileSize + 3;
+    for (int samples : {1, 4, 16}) {
+        mr::RenderSettings s = settings(W, H, samples, samples == 16 ? mr::PatternKind::stratified
+                                                                     : mr::PatternKind::automatic);
+        s.keep_samples = false;
+        s.estimate_error = samples > 1;
+        s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+        const std::vector<mr::Draw> draws = {make_draw(m, glm::dmat4(1.0), no_depth())};
+        const mr::RenderResult full = mr::render(draws, identity_camera(), s);
+        // Scattered pixels, a run across a tile border, a repeat, the last pixel, and most of the
+        // first tile (rasterized whole, then resolved only where listed).
+        std::vector<bool> wanted(std::size_t(W) * H, false);
+        for (std::uint32_t p = 0; p < std::uint32_t(W * H); p += 37) s.pixels.push_back(p);
+        for (int y = 0; y < 26; ++y)
+            for (int x = 0; x < mr::kTileSize; x += (y == 7 ? 2 : 1)) s.pixels.push_back(std::uint32_t(y * W + x));
+        for (int x = mr::kTileSize - 3; x < mr::kTileSize + 4; ++x) s.pixels.push_back(std::uint32_t(20 * W + x));
+        s.pixels.push_back(s.pixels.front());
+        s.pixels.push_back(std::uint32_t(W * H - 1));
+        for (std::uint32_t p : s.pixels) wanted[p] = true;
+        const mr::RenderResult part = mr::render(draws, identity_camera(), s);
+        int edge = 0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                const bool in = wanted[std::size_t(y) * W + x];
+                for (int c = 0; c < 4; ++c)
+                    ASSERT_EQ(part.color.at(x, y, c), in ? full.color.at(x, y, c) : s.clear_color[c])
+                        << samples << " spp, " << x << "," << y << " c" << c;
+                if (samples > 1) {
+                    ASSERT_EQ(part.error_map.at(x, y, 0), in ? full.error_map.at(x, y, 0) : 0.0f) << x << "," << y;
+                    edge += in && full.error_map.at(x, y, 0) > 0;
+                }
+            }
+        if (samples > 1) EXPECT_GT(edge, 0) << "some listed pixel lies on an edge";
+        EXPECT_LT(part.stats.samples_covered, full.stats.samples_covered);
+    }
+}
+
+TEST(ListedPixels, BadInputIsNamed) {
+    const mr::Mesh m = slanted_triangle();
+    mr::RenderSettings s = settings(10, 10, 4);
+    const std::vector<mr::Draw> draws = {make_draw(m, glm::dmat4(1.0), no_depth())};
+    auto message = [&]() -> std::string {
+        try {
+            mr::render(draws, identity_camera(), s);
+        } catch (const std::invalid_argument& e) {
+            return e.what();
+        }
+        return "no exception";
+    };
+    s.pixels = {3, 100};
+    EXPECT_NE(message().find("pixels[1] = 100 is outside the 10x10 image"), std::string::npos) << message();
+    s.pixels = {3};
+    s.tile_mask = {1};
+    EXPECT_NE(message().find("not both"), std::string::npos) << message();
+    s.tile_mask.clear();
+    s.resolve_filter = mr::ResolveFilter::tent;
+    EXPECT_NE(message().find("needs the box resolve"), std::string::npos) << message();
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
-"""The per-render error estimate (render(..., estimate_error=True)) and adaptive quality
-(render(..., target_error=e)), checked against exact references (mipraster.reference)."""
+"""The per-render error estimate (render(..., estimate_error=True): the halves map and the sparse
+reference probe) and adaptive quality (render(..., target_error=e)), checked against exact
+references (mipraster.reference)."""
 import math
 
 import numpy as np
@@ -7,23 +8,27 @@ import pytest
 
 import mipraster as mr
 from mipraster import _core
-from mipraster.adaptive import tile_rmse
+from mipraster.adaptive import MAX_PASSES, plan_refinement
+from mipraster.error_probe import default_pixel_count, guide
 from mipraster.reference import exact_coverage, image_error
-from mipraster.study_scenes import checker_plane, star, with_filter
+from mipraster.study_scenes import checker_plane, shapes, star, with_filter, zone_plate
 
 
-def test_estimate_needs_two_samples():
+def test_halves_and_adaptive_need_two_samples():
     s = star(32, 32)
     with pytest.raises(ValueError, match="spp >= 2"):
-        mr.render(s.scene, s.camera, 32, 32, spp=1, estimate_error=True)
+        mr.render(s.scene, s.camera, 32, 32, spp=1, estimate_error=True, probe_pixels=0)
     with pytest.raises(ValueError, match="spp >= 2"):
         mr.render(s.scene, s.camera, 32, 32, spp=1, target_error=0.01)
+    # The probe alone works at one sample per pixel: an estimate, no map.
+    r = mr.render(s.scene, s.camera, 32, 32, spp=1, estimate_error=True)
+    assert r.error_map is None and r.error_estimate > 0 and r.error_probe.halves_rmse is None
 
 
 def test_no_estimate_unless_asked():
     s = star(32, 32)
     r = mr.render(s.scene, s.camera, 32, 32, spp=4)
-    assert r.error_map is None and r.error_estimate is None and r.tile_spp is None
+    assert r.error_map is None and r.error_estimate is None and r.pixel_spp is None and r.error_probe is None
 
 
 def test_flat_image_estimates_zero():
@@ -32,13 +37,14 @@ def test_flat_image_estimates_zero():
     scene.add(quad, color=(0.3, 0.6, 0.9), depth_test=False)
     r = mr.render(scene, mr.Camera.orthographic((0, 0, 1), (0, 0, 0)), 40, 30, spp=8, estimate_error=True)
     assert r.error_map.shape == (30, 40)
-    assert r.error_estimate == 0.0
+    assert r.error_estimate < 1e-6  # the reference's 64 samples may round differently in the last bit
     assert np.all(r.error_map == 0.0)
 
 
 def test_estimate_is_half_the_disagreement_of_the_halves():
     s = star(48, 40)
-    r = mr.render(s.scene, s.camera, 48, 40, spp=16, pattern="stratified", keep_samples=True, estimate_error=True)
+    r = mr.render(s.scene, s.camera, 48, 40, spp=16, pattern="stratified", keep_samples=True, estimate_error=True,
+                  probe_pixels=0)
     halves = np.array(_core.interleaved_halves(_core.PatternKind.stratified, 16, 0), dtype=bool)
     a = r.samples[:, :, ~halves, :3].astype(np.float64).mean(axis=2)
     b = r.samples[:, :, halves, :3].astype(np.float64).mean(axis=2)
@@ -50,22 +56,66 @@ def test_estimate_is_half_the_disagreement_of_the_halves():
 
 @pytest.mark.parametrize("make, spp, pattern", [(star, 16, "stratified"), (star, 8, "auto"),
                                                 (checker_plane, 16, "stratified")])
-def test_estimate_calibration(make, spp, pattern):
-    # The estimate against the true RMSE (exact / brute-force reference): within a factor of 2 where
-    # the error is sampling error: edges, and a texture read at level 0 (bilinear, no mip levels:
-    # each sample is a point of the footprint integral). A mip-mapped filter adds a bias that both
-    # halves share and the estimate cannot see (the study reports that ratio).
+def test_halves_calibration(make, spp, pattern):
+    # The halves estimate alone (probe_pixels=0) against the true RMSE (exact / brute-force
+    # reference): within a factor of 2 where the error is sampling error: edges, and a texture read
+    # at level 0 (bilinear, no mip levels: each sample is a point of the footprint integral).
     s = make(64, 48)
     ref, residual, _ = s.reference(1.0)
     scene = with_filter(s.scene, "bilinear")
-    r = mr.render(scene, s.camera, s.width, s.height, spp=spp, pattern=pattern, estimate_error=True)
+    r = mr.render(scene, s.camera, s.width, s.height, spp=spp, pattern=pattern, estimate_error=True, probe_pixels=0)
     true = image_error(r.color, ref)["rmse"]
     assert residual < 0.25 * true  # the reference is good enough to judge
     assert 0.5 <= r.error_estimate / true <= 2.0, (r.error_estimate, true)
 
 
+@pytest.mark.parametrize("make, spp, aa, filt", [
+    (star, 1, "ssaa", None), (star, 4, "ssaa", None), (shapes, 2, "ssaa", None),
+    (checker_plane, 4, "msaa", "trilinear"), (checker_plane, 1, "ssaa", "trilinear"),
+    (zone_plate, 4, "msaa", "trilinear"), (zone_plate, 1, "ssaa", None)])
+def test_probe_calibration(make, spp, aa, filt):
+    # The full estimate (halves map calibrated by the sparse reference) where the halves alone see
+    # little or nothing: one sample per pixel, MSAA's one shade per pixel, a mip-mapped filter's
+    # blur. Against the exact / brute-force reference: within a factor of 2.
+    s = make(64, 48)
+    ref, residual, _ = s.reference(1.0)
+    scene = with_filter(s.scene, filt) if filt else s.scene
+    r = mr.render(scene, s.camera, s.width, s.height, spp=spp, aa=aa, estimate_error=True)
+    true = image_error(r.color, ref)["rmse"]
+    assert residual < 0.25 * true
+    assert 0.5 <= r.error_estimate / true <= 2.0, (r.error_estimate, true, r.error_probe)
+    assert r.error_probe.pixels == default_pixel_count(64, 48, spp)
+    assert 0 < r.error_probe.stderr < r.error_estimate
+    if r.error_map is not None and r.error_probe.halves_rmse > 0:  # the map is scaled to the estimate
+        assert math.sqrt(np.mean(r.error_map.astype(np.float64) ** 2)) == pytest.approx(r.error_estimate, rel=1e-5)
+
+
+def test_probe_is_unbiased():
+    # The mean of the probe's MSE over many seeds (each a new stratified pattern for the render and
+    # a new choice of pixels) against the mean of the true MSE, with the exact-coverage reference.
+    s = star(48, 40)
+    ref, _, _ = s.reference(1.0)
+    est, true = [], []
+    for seed in range(12):
+        r = mr.render(s.scene, s.camera, 48, 40, spp=4, pattern="stratified", seed=seed, estimate_error=True,
+                      probe_pixels=64)
+        est.append(r.error_estimate ** 2)
+        true.append(image_error(r.color, ref)["rmse"] ** 2)
+    assert np.mean(est) == pytest.approx(np.mean(true), rel=0.25), (np.mean(est), np.mean(true))
+
+
+def test_probe_is_deterministic_for_any_thread_count():
+    s = zone_plate(40, 30)
+    a = mr.render(s.scene, s.camera, 40, 30, spp=4, estimate_error=True, threads=1)
+    b = mr.render(s.scene, s.camera, 40, 30, spp=4, estimate_error=True, threads=2)
+    assert a.error_estimate == b.error_estimate and a.error_probe.stderr == b.error_probe.stderr
+    np.testing.assert_array_equal(a.error_map, b.error_map)
+    c = mr.render(s.scene, s.camera, 40, 30, spp=4, estimate_error=True, threads=2, seed=1)
+    assert c.error_estimate != a.error_estimate  # another seed, another choice of pixels
+
+
 def _corner_triangle(width, height):
-    # One triangle in the top-left tile (pixel coordinates, as the study's star): every other tile
+    # One triangle in the top-left tile (pixel coordinates, as the study's star): every other pixel
     # is flat background with no error.
     tri = np.array([[(3.0, 4.0), (27.0, 9.0), (9.0, 26.0)]])
     mesh = mr.Mesh(np.c_[tri[0], np.zeros(3)] * [1, -1, 1], [[0, 1, 2]], colors=np.ones((3, 3)))
@@ -76,6 +126,19 @@ def _corner_triangle(width, height):
     return scene, camera, exact_coverage(tri, np.ones((1, 3)), width, height, (0.0, 0.0, 0.0))
 
 
+def _partly_covered(ref):
+    return (ref[..., 0] > 0) & (ref[..., 0] < 1)
+
+
+def _dilate(mask, steps):
+    out = mask.copy()
+    for _ in range(steps):
+        grown = np.pad(out, 1)
+        h, w = mask.shape
+        out = np.any([grown[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)], axis=0)
+    return out
+
+
 @pytest.mark.parametrize("spp, pattern", [(4, "auto"), (4, "stratified"), (2, "auto")])
 def test_adaptive_refines_only_where_needed(spp, pattern):
     scene, camera, ref = _corner_triangle(96, 64)
@@ -84,24 +147,56 @@ def test_adaptive_refines_only_where_needed(spp, pattern):
     assert image_error(base.color, ref)["rmse"] > 0
     target = base.error_estimate / 3
     r = mr.render(scene, camera, 96, 64, spp=spp, pattern=pattern, target_error=target, clear_color=clear)
-    assert r.tile_spp.shape == (2, 3)
-    # The image's estimate meets the target, or the tile with the edges has run out of samples.
-    assert r.error_estimate <= target or r.tile_spp[0, 0] == _core.MAX_SAMPLES
-    assert r.tile_spp[0, 0] > spp
-    # The flat tiles were not rendered again: base samples, the base render's pixels.
-    t = _core.TILE_SIZE
-    for ty, tx in [(0, 1), (0, 2), (1, 0), (1, 1), (1, 2)]:
-        assert r.tile_spp[ty, tx] == spp
-        np.testing.assert_array_equal(r.color[ty * t:(ty + 1) * t, tx * t:(tx + 1) * t],
-                                      base.color[ty * t:(ty + 1) * t, tx * t:(tx + 1) * t])
+    assert r.pixel_spp.shape == (64, 96)
+    near_edges = guide(base.color, base.error_map) > 0  # estimated error nearby, or a colour step
+    # The image's estimate meets the target, or the pixels with error have run out of samples.
+    assert r.error_estimate <= target or np.all(r.pixel_spp[near_edges] == _core.MAX_SAMPLES)
+    assert r.pixel_spp.max() > spp
+    # Only pixels near the triangle's edges (partly covered in the exact reference; the guide
+    # reaches a pixel beyond, and each pass one more) were rendered again; the others are the
+    # base render's.
+    refined = r.pixel_spp > spp
+    assert np.all(_dilate(_partly_covered(ref), MAX_PASSES + 1)[refined])
+    assert refined.sum() < 0.2 * refined.size
+    np.testing.assert_array_equal(r.color[~refined], base.color[~refined])
     # And the true error went down.
     assert image_error(r.color, ref)["rmse"] < image_error(base.color, ref)["rmse"]
 
 
 def test_adaptive_unreachable_target_stops_at_64():
-    scene, camera, _ = _corner_triangle(64, 32)
+    scene, camera, ref = _corner_triangle(64, 32)
+    base = mr.render(scene, camera, 64, 32, spp=4, estimate_error=True)
     r = mr.render(scene, camera, 64, 32, spp=4, target_error=1e-9)
-    assert r.tile_spp.tolist() == [[_core.MAX_SAMPLES, 4]]
+    near_edges = guide(base.color, base.error_map) > 0
+    assert set(np.unique(r.pixel_spp)) == {4, _core.MAX_SAMPLES}
+    assert np.all(r.pixel_spp[near_edges] == _core.MAX_SAMPLES)
+    assert np.all(_dilate(_partly_covered(ref), MAX_PASSES + 1)[r.pixel_spp > 4])
+
+
+def test_plan_is_the_cheapest_single_pass():
+    # Brute force over every subset of pixels and every sample count: the plan's new samples are
+    # the fewest of any one pass whose predicted error (∝ 1/√spp) meets the target.
+    rng = np.random.default_rng(5)
+    for trial in range(20):
+        error = rng.uniform(0, 1, 7) * (rng.uniform(0, 1, 7) > 0.2)
+        spp = rng.choice([4, 8, 16], 7)
+        target = math.sqrt(np.mean(error ** 2)) * rng.uniform(0.2, 0.9)
+        best = None
+        for s in sorted({4 * 2 ** k for k in range(1, 5)} | {64}):
+            for bits in range(1, 2 ** 7):
+                mask = np.array([(bits >> i) & 1 for i in range(7)], dtype=bool)
+                if np.any(spp[mask] >= s) or np.any(error[mask] == 0):
+                    continue
+                after = np.where(mask, error * np.sqrt(spp / s), error)
+                if np.mean(after ** 2) <= target ** 2 * (1 + 1e-9) and (best is None or mask.sum() * s < best):
+                    best = mask.sum() * s
+        plan = plan_refinement(error, spp, target, 4)
+        assert plan is not None
+        mask, s = plan
+        if best is None:  # unreachable in one pass: every pixel with error at 64
+            assert s == 64 and np.array_equal(mask, (error > 0) & (spp < 64))
+        else:
+            assert mask.sum() * s == best, (trial, mask, s, best)
 
 
 def test_adaptive_bad_input():
@@ -113,6 +208,22 @@ def test_adaptive_bad_input():
         mr.render(s.scene, s.camera, 32, 32, spp=4, target_error="small")
     with pytest.raises(ValueError, match="keep the samples"):
         mr.render(s.scene, s.camera, 32, 32, spp=4, target_error=0.01, keep_samples=True)
+    with pytest.raises(ValueError, match="box resolve"):
+        mr.render(s.scene, s.camera, 32, 32, spp=4, target_error=0.01, resolve_filter="tent")
+    with pytest.raises(ValueError, match="probe_pixels"):
+        mr.render(s.scene, s.camera, 32, 32, spp=4, estimate_error=True, probe_pixels=-1)
+    with pytest.raises(TypeError, match="probe_pixels"):
+        mr.render(s.scene, s.camera, 32, 32, spp=4, estimate_error=True, probe_pixels="many")
+
+
+def test_pixel_list_is_checked():
+    s = star(40, 40)
+    settings = _core.RenderSettings()
+    settings.width = settings.height = 40
+    settings.samples = 4
+    settings.pixels = [5, 1600]
+    with pytest.raises(ValueError, match=r"pixels\[1\] = 1600 is outside the 40x40 image"):
+        _core.render([d._draw for d in s.scene.draws], s.camera.build(40, 40), settings)
 
 
 def test_tile_mask_size_is_checked():
@@ -150,7 +261,7 @@ def test_cli_error_map(tmp_path):
     assert r.returncode == 0, r.stderr
     written = mr.read_image(out)
     scene, camera = mr.Scene.demo()
-    expected = mr.render(scene, camera, 64, 36, spp=8, aa="ssaa", estimate_error=True).error_map
+    expected = mr.render(scene, camera, 64, 36, spp=8, aa="ssaa", estimate_error=True, probe_pixels=0).error_map
     np.testing.assert_allclose(np.asarray(written).reshape(36, 64, -1)[..., 0], expected, atol=1e-6)
     assert expected.max() > 0
     r = subprocess.run([EXE, "render", "-o", str(tmp_path / "b.png"), "--spp", "1", "--error-map", str(out)],

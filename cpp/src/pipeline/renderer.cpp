@@ -265,6 +265,41 @@ std::uint64_t render_bytes(const std::vector<Draw>& draws, const RenderSettings&
     return bytes;
 }
 
+// Sparse listed pixels (RenderSettings::pixels) cost 1.7–3× a pixel of a whole tile (each span
+// repeats the edge setup of the tile's triangles): from this share of a tile's pixels on, the
+// tile is rasterized whole.
+constexpr double kWholeTileShare = 0.5;
+static_assert(kWholeTileShare > 0.0 && kWholeTileShare <= 1.0, "a share of a tile's pixels");
+
+// One row of listed pixels inside one tile: [x0, x1) × [y, y + 1).
+struct PixelSpan {
+    int y, x0, x1;
+};
+
+// RenderSettings::pixels as row spans per tile (empty lists when no pixels are listed). Throws
+// std::invalid_argument for an index outside the image.
+std::vector<std::vector<PixelSpan>> pixel_spans(const std::vector<std::uint32_t>& pixels, const TileGrid& grid) {
+    std::vector<std::vector<PixelSpan>> spans(static_cast<std::size_t>(grid.count()));
+    const std::uint64_t n = std::uint64_t(grid.width) * std::uint64_t(grid.height);
+    for (std::size_t i = 0; i < pixels.size(); ++i)
+        if (pixels[i] >= n)
+            throw std::invalid_argument("pixels[" + std::to_string(i) + "] = " + std::to_string(pixels[i]) +
+                                        " is outside the " + std::to_string(grid.width) + "x" +
+                                        std::to_string(grid.height) + " image (expected y * width + x < " +
+                                        std::to_string(n) + ")");
+    std::vector<std::uint32_t> sorted = pixels;
+    std::sort(sorted.begin(), sorted.end());
+    sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+    for (std::uint32_t p : sorted) {  // row-major order: a tile's spans come row by row, left to right
+        const int x = static_cast<int>(p % std::uint32_t(grid.width));
+        const int y = static_cast<int>(p / std::uint32_t(grid.width));
+        std::vector<PixelSpan>& tile = spans[std::size_t(y / kTileSize) * grid.tiles_x + std::size_t(x / kTileSize)];
+        if (!tile.empty() && tile.back().y == y && tile.back().x1 == x) ++tile.back().x1;
+        else tile.push_back({y, x, x + 1});
+    }
+    return spans;
+}
+
 std::string render_description(int width, int height, int samples) {
     return std::to_string(width) + "x" + std::to_string(height) + " pixels at " + std::to_string(samples) +
            (samples == 1 ? " sample" : " samples") + " per pixel";
@@ -298,6 +333,11 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                                         std::to_string(g.tiles_x) + " x " + std::to_string(g.tiles_y) +
                                         " tiles of " + std::to_string(kTileSize) + " px), got " +
                                         std::to_string(settings.tile_mask.size()));
+        if (!settings.pixels.empty() && !settings.tile_mask.empty())
+            throw std::invalid_argument("pixels: give either a pixel list or a tile_mask, not both");
+        if (!settings.pixels.empty() && settings.resolve_filter != ResolveFilter::box && settings.samples > 1)
+            throw std::invalid_argument("pixels: a render of listed pixels needs the box resolve (a " +
+                                        to_string(settings.resolve_filter) + " filter reads unrendered neighbours)");
     }
     const bool depth_output = settings.depth_output && needs_depth;
     const DepthDecoder decoder = depth_output ? camera.depth_decoder() : DepthDecoder{};
@@ -372,19 +412,22 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 inputs[d].footprint_scale = glm::dvec2(1.0 / result.pattern.columns, 1.0 / result.pattern.rows);
         }
     }
+    const std::vector<std::vector<PixelSpan>> spans = pixel_spans(settings.pixels, grid);
+    const bool listed = !settings.pixels.empty();
     std::vector<TileCounters> tile_counters(static_cast<std::size_t>(grid.count()));
     std::mutex progress_mutex;
     std::size_t tiles_done = 0;
     pool.parallel_for(static_cast<std::size_t>(grid.count()), [&](std::size_t tile) {
         TileTarget target = tile_target(grid, tile, result.pattern);
-        if (!settings.tile_mask.empty() && !settings.tile_mask[tile]) {
-            // Not asked for: the clear colour, no samples drawn, no error.
+        const bool masked = !settings.tile_mask.empty() && !settings.tile_mask[tile];
+        if (masked || listed) {
+            // Pixels not asked for: the clear colour, no samples drawn, no error.
             SampleWindow image{result.color.pixels.data(), 4, 0, 0, settings.width, 1};
             image.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
             if (depth_output)
                 SampleWindow{result.depth.pixels.data(), 1, 0, 0, settings.width, 1}.fill(
                     target.x0, target.y0, target.x1, target.y1, glm::vec4(std::numeric_limits<float>::infinity()));
-            return;
+            if (masked || spans[tile].empty()) return;
         }
         // Tile-local storage, reused by each worker thread from tile to tile.
         thread_local std::vector<float> tile_color, tile_depth;
@@ -398,21 +441,48 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 tile_color.resize(std::size_t{4} * kTileSize * kTileSize * static_cast<std::size_t>(S));
                 target.color = {tile_color.data(), 4, target.x0, target.y0, kTileSize, S};
             }
-            target.color.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
             if (needs_depth) {
                 tile_depth.resize(std::size_t{kTileSize} * kTileSize * static_cast<std::size_t>(S));
                 target.depth = {tile_depth.data(), 1, target.x0, target.y0, kTileSize, S};
-                target.depth.fill(target.x0, target.y0, target.x1, target.y1, clear_depth4);
             }
         }
-        rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
-        if ((settings.keep_samples || S > 1) && !wide_resolve)
-            resolve_tile(target.color, target.x0, target.y0, target.x1, target.y1, settings.resolve_filter, result.color);
-        if (settings.estimate_error)
-            estimate_tile_error(target.color, halves, target.x0, target.y0, target.x1, target.y1, result.error_map);
-        if (depth_output)
-            resolve_view_depth(target.depth, target.x0, target.y0, target.x1, target.y1, clear_depth, decoder,
-                               result.depth);
+        // The whole tile, or each listed span of it (a span is a thin tile: the kernel clips every
+        // triangle's bounding box to the target's rectangle). Each span repeats the edge setup of
+        // every triangle in the tile, so a tile with at least kWholeTileShare of its pixels listed
+        // is rasterized whole into its tile-local buffer and only the listed spans are resolved
+        // (not with S == 1 or a kept framebuffer, where the samples are the output).
+        const PixelSpan whole{target.y0, target.x0, target.x1};
+        const PixelSpan* first = listed ? spans[tile].data() : &whole;
+        const PixelSpan* last = listed ? first + spans[tile].size() : &whole + 1;
+        int listed_pixels = 0;
+        for (const PixelSpan* span = first; span != last; ++span) listed_pixels += span->x1 - span->x0;
+        const int tile_pixels = (target.x1 - target.x0) * (target.y1 - target.y0);
+        const bool rasterize_whole =
+            !listed || (S > 1 && !whole_frame && listed_pixels >= kWholeTileShare * tile_pixels);
+        if (rasterize_whole) {
+            if (!whole_frame) {  // a kept framebuffer starts cleared
+                target.color.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
+                if (needs_depth) target.depth.fill(target.x0, target.y0, target.x1, target.y1, clear_depth4);
+            }
+            rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
+        }
+        for (const PixelSpan* span = first; span != last; ++span) {
+            TileTarget part = target;
+            if (listed) part.x0 = span->x0, part.x1 = span->x1, part.y0 = span->y, part.y1 = span->y + 1;
+            if (!rasterize_whole) {
+                if (!whole_frame) {
+                    part.color.fill(part.x0, part.y0, part.x1, part.y1, settings.clear_color);
+                    if (needs_depth) part.depth.fill(part.x0, part.y0, part.x1, part.y1, clear_depth4);
+                }
+                rasterize_tile_chunks(tile, chunks, kernels, inputs, part, tile_counters[tile]);
+            }
+            if ((settings.keep_samples || S > 1) && !wide_resolve)
+                resolve_tile(part.color, part.x0, part.y0, part.x1, part.y1, settings.resolve_filter, result.color);
+            if (settings.estimate_error)
+                estimate_tile_error(part.color, halves, part.x0, part.y0, part.x1, part.y1, result.error_map);
+            if (depth_output)
+                resolve_view_depth(part.depth, part.x0, part.y0, part.x1, part.y1, clear_depth, decoder, result.depth);
+        }
         if (settings.progress) {
             std::lock_guard<std::mutex> lock(progress_mutex);
             settings.progress(++tiles_done, static_cast<std::size_t>(grid.count()));
@@ -517,7 +587,8 @@ std::string RenderSettings::to_string() const {
            mipraster::to_string(resolve_filter) + ", derivatives=" + mipraster::to_string(derivatives) +
            ", debug_view=" + mipraster::to_string(debug_view) +
            (estimate_error ? ", estimate_error" : "") +
-           (tile_mask.empty() ? "" : ", tile_mask=" + std::to_string(tile_mask.size()) + " tiles") + ")";
+           (tile_mask.empty() ? "" : ", tile_mask=" + std::to_string(tile_mask.size()) + " tiles") +
+           (pixels.empty() ? "" : ", pixels=" + std::to_string(pixels.size())) + ")";
 }
 
 std::string RenderStats::to_json() const {

@@ -49,6 +49,12 @@ struct RenderSettings {
     /// ⌈W/kTileSize⌉ × ⌈H/kTileSize⌉: only flagged tiles are rendered, the others keep the clear
     /// colour (adaptive sampling re-renders the tiles that need more samples).
     std::vector<std::uint8_t> tile_mask;
+    /// Empty: render every pixel. Otherwise the row-major indices y·W + x of the only pixels to
+    /// render (any order, repeats ignored); the others keep the clear colour and no error. Each
+    /// row of listed pixels in a tile is rasterized as one span, after one transform and setup of
+    /// the scene (a sparse reference and per-pixel refinement render few pixels with many
+    /// samples). Not with tile_mask, nor with a resolve filter wider than a pixel.
+    std::vector<std::uint32_t> pixels;
     /// Called as tiles finish with (tiles done, tiles in all); calls are serialized (never
     /// concurrent) but may come from any worker thread. Empty: no progress reports.
     std::function<void(std::size_t, std::size_t)> progress;
