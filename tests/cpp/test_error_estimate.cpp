@@ -168,7 +168,9 @@ TEST(ListedPixels, RenderOnlyThoseExactly) {
                     edge += in && full.error_map.at(x, y, 0) > 0;
                 }
             }
-        if (samples > 1) EXPECT_GT(edge, 0) << "some listed pixel lies on an edge";
+        if (samples > 1) {
+            EXPECT_GT(edge, 0) << "some listed pixel lies on an edge";
+        }
         EXPECT_LT(part.stats.samples_covered, full.stats.samples_covered);
     }
 }
