@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 
@@ -43,14 +44,20 @@ inline int ceil_int(double x) {
     const int i = static_cast<int>(x);
     return i + (x > i);
 }
+// std::floor of a finite x without the library call: from 2^52 on every double is an integer.
+inline double floor_double(double x) {
+    if (!(std::abs(x) < 0x1p52)) return x;
+    const double t = static_cast<double>(static_cast<std::int64_t>(x));
+    return t - (x < t);
+}
 
 // A texel-space coordinate moved by whole periods (repeat, mirror) or clamped just past the
 // edges (clamp, border), so that its floor and the indices next to it fit an int. No float
 // reaches an int conversion before this (DESIGN.md §2.6).
 [[gnu::noinline]] double reduce_outside(double x, int n, WrapMode mode) {
     switch (mode) {
-        case WrapMode::repeat: return x - n * std::floor(x / n);
-        case WrapMode::mirror: return x - 2.0 * n * std::floor(x / (2.0 * n));
+        case WrapMode::repeat: return x - n * floor_double(x / n);
+        case WrapMode::mirror: return x - 2.0 * n * floor_double(x / (2.0 * n));
         default: return std::clamp(x, -2.0, n + 2.0);
     }
 }
@@ -129,6 +136,12 @@ inline Texel bilinear(const TextureLevel& level, double u, double v, const Sampl
     return lerp_quad(load(row[0]), load(row[1]), load(row[level.width]), load(row[level.width + 1]), ax, ay);
 }
 
+template <TexelFilter kFilter>
+inline Texel texel_filter(const TextureLevel& level, double u, double v, const Sampler& s) {
+    if constexpr (kFilter == TexelFilter::nearest) return nearest(level, u, v, s);
+    else return bilinear(level, u, v, s);
+}
+
 Texel texel_filter(const TextureLevel& level, double u, double v, TexelFilter filter, const Sampler& s) {
     return filter == TexelFilter::nearest ? nearest(level, u, v, s) : bilinear(level, u, v, s);
 }
@@ -168,27 +181,29 @@ bool plainly_magnifies(double rho2, const Sampler& s) {
 }
 
 double isotropic_lod(const Footprint& f, const Sampler& s, int levels) {
-    if (!f.finite()) return lod_from_log2_size(kInf, s, levels);
     const double rho2 = std::max(f.length2_x(), f.length2_y());
+    if (!(rho2 < kInf)) return lod_from_log2_size(kInf, s, levels);  // (the lengths are NaN or ∞ when not finite)
     if (plainly_magnifies(rho2, s)) return 0.0;
     return lod_from_log2_size(log2_size(rho2), s, levels);
 }
 
-// Minification within the mip chain at λ > 0 with the sampler's min and mip filters.
+// Minification within the mip chain at λ > 0 with the sampler's mip filter and min filter kFilter
+// (a template argument, so that trilinear's two quads inline).
+template <TexelFilter kFilter>
 Texel mip_filter(const TextureView& t, double u, double v, double lambda, const Sampler& s) {
     switch (s.mip_filter) {
-        case MipFilter::none: return texel_filter(t.level(0), u, v, s.min_filter, s);
+        case MipFilter::none: return texel_filter<kFilter>(t.level(0), u, v, s);
         case MipFilter::nearest: {
             // GL's choice: level ⌈λ + ½⌉ − 1, so λ ≤ ½ stays on level 0.
             const int k = std::clamp(ceil_int(lambda + 0.5) - 1, 0, t.level_count() - 1);
-            return texel_filter(t.level(k), u, v, s.min_filter, s);
+            return texel_filter<kFilter>(t.level(k), u, v, s);
         }
         case MipFilter::linear: {
             const int k = std::min(static_cast<int>(lambda), t.level_count() - 1);
             const double f = lambda - k;
-            const Texel a = texel_filter(t.level(k), u, v, s.min_filter, s);
+            const Texel a = texel_filter<kFilter>(t.level(k), u, v, s);
             if (f <= 0.0 || k + 1 >= t.level_count()) return a;
-            return lerp(a, texel_filter(t.level(k + 1), u, v, s.min_filter, s), static_cast<float>(f));
+            return lerp(a, texel_filter<kFilter>(t.level(k + 1), u, v, s), static_cast<float>(f));
         }
     }
     return splat(0.0f);
@@ -197,7 +212,8 @@ Texel mip_filter(const TextureView& t, double u, double v, double lambda, const 
 // Isotropic: one mip lookup at λ, or the magnification filter when λ ≤ 0.
 Texel isotropic(const TextureView& t, double u, double v, double lambda, const Sampler& s) {
     if (lambda <= 0.0) return texel_filter(t.level(0), u, v, s.mag_filter, s);
-    return mip_filter(t, u, v, lambda, s);
+    if (s.min_filter == TexelFilter::linear) return mip_filter<TexelFilter::linear>(t, u, v, lambda, s);
+    return mip_filter<TexelFilter::nearest>(t, u, v, lambda, s);
 }
 
 // EXT_texture_filter_anisotropic: N = min(⌈Pmax/Pmin⌉, max anisotropy) probes spaced evenly
@@ -219,12 +235,12 @@ const std::array<double, kMostProbes + 1> kLog2Count = [] {
 
 AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const Sampler& s, int levels) {
     AnisoProbes p;
-    if (!f.finite()) {
+    const double px2 = f.length2_x(), py2 = f.length2_y();
+    if (!(px2 < kInf && py2 < kInf)) {  // some derivative not finite
         p.lambda = lod_from_log2_size(kInf, s, levels);
         p.magnifies = p.lambda <= 0.0;
         return p;
     }
-    const double px2 = f.length2_x(), py2 = f.length2_y();
     const double pmax2 = std::max(px2, py2), pmin2 = std::min(px2, py2);
     if (plainly_magnifies(pmax2, s)) {
         p.magnifies = true;
@@ -241,8 +257,12 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
     // max_anisotropy is any finite float ≥ 1: bound it before the int conversion (UB beyond 2³¹).
     const int max_n = static_cast<int>(std::clamp(double(s.max_anisotropy), 1.0, double(kMostProbes)));
     // ⌈Pmax/Pmin⌉ from the squares; Pmin = 0 gives ∞ or NaN, both max_n.
-    const double ratio2 = pmax2 / pmin2;
-    p.count = ratio2 < double(max_n) * max_n ? std::max(1, ceil_int(std::sqrt(ratio2))) : max_n;
+    if (pmax2 == pmin2 && pmin2 > 0.0) {  // isotropic: neither the division nor the root
+        p.count = 1;
+    } else {
+        const double ratio2 = pmax2 / pmin2;
+        p.count = ratio2 < double(max_n) * max_n ? std::max(1, ceil_int(std::sqrt(ratio2))) : max_n;
+    }
     p.lambda = lod_from_log2_size(p.count == 1 ? log2_pmax : log2_pmax - kLog2Count[p.count], s, levels);
     const glm::vec2 major = px2 >= py2 ? dx : dy;
     p.du = major.x;
