@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <random>
 #include <sstream>
@@ -50,6 +51,24 @@ TEST(TextureAnisotropic, LodFollowsExtRuleOnHandValues) {
     s.max_anisotropy = 16.0f;
     EXPECT_EQ(mr::texture_lod(view, s, major, {0.0f, 0.0f}), 0.0);  // Pmin = 0 → N = 16, log2(1)
     EXPECT_EQ(mr::texture_lod(view, s, {0.5f / 256, 0.0f}, {0.0f, 0.01f / 256}), 0.0);  // magnified
+}
+
+// A NaN or infinite component in either derivative gives the coarsest level (texture_lod's
+// contract) for every footprint filter, whatever the other derivative is: also when the other
+// one is finite and longer, so that a max() of the lengths could hide the NaN.
+TEST(TextureLod, NonFiniteDerivativeGivesCoarsestLevel) {
+    mr::Texture tex(to::random_level(256, 256, 1), "random");
+    mr::TextureView view(tex);
+    const double coarsest = view.level_count() - 1;
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    const glm::vec2 finite(3.0f / 256, 0.5f / 256);
+    for (const char* name : {"trilinear", "anisotropic", "ewa", "sat"}) {
+        const mr::Sampler s = mr::Sampler::from_filter_name(name);
+        for (const glm::vec2 bad : {glm::vec2(nan, 0.0f), glm::vec2(0.0f, nan), glm::vec2(inf, 0.0f), glm::vec2(0.0f, -inf)}) {
+            EXPECT_EQ(mr::texture_lod(view, s, finite, bad), coarsest) << name << " dy " << bad.x << ", " << bad.y;
+            EXPECT_EQ(mr::texture_lod(view, s, bad, finite), coarsest) << name << " dx " << bad.x << ", " << bad.y;
+        }
+    }
 }
 
 // texture_lod of the anisotropic footprint equals the EXT rule on random footprints (λ of the

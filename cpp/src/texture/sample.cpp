@@ -181,8 +181,9 @@ bool plainly_magnifies(double rho2, const Sampler& s) {
 }
 
 double isotropic_lod(const Footprint& f, const Sampler& s, int levels) {
-    const double rho2 = std::max(f.length2_x(), f.length2_y());
-    if (!(rho2 < kInf)) return lod_from_log2_size(kInf, s, levels);  // (the lengths are NaN or ∞ when not finite)
+    const double lx = f.length2_x(), ly = f.length2_y();
+    if (!(lx < kInf && ly < kInf)) return lod_from_log2_size(kInf, s, levels);  // some derivative not finite
+    const double rho2 = std::max(lx, ly);
     if (plainly_magnifies(rho2, s)) return 0.0;
     return lod_from_log2_size(log2_size(rho2), s, levels);
 }
