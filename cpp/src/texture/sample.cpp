@@ -191,7 +191,7 @@ double isotropic_lod(const Footprint& f, const Sampler& s, int levels) {
 // Minification within the mip chain at λ > 0 with the sampler's mip filter and min filter kFilter
 // (a template argument, so that trilinear's two quads inline).
 template <TexelFilter kFilter>
-Texel mip_filter(const TextureView& t, double u, double v, double lambda, const Sampler& s) {
+[[gnu::noinline]] Texel mip_filter(const TextureView& t, double u, double v, double lambda, const Sampler& s) {
     switch (s.mip_filter) {
         case MipFilter::none: return texel_filter<kFilter>(t.level(0), u, v, s);
         case MipFilter::nearest: {
@@ -276,7 +276,7 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
 // exactly. The filter is a template argument so that it inlines into the loops: they are most of
 // an anisotropic lookup's time.
 template <TexelFilter kFilter>
-Texel probe_mean(const AnisoProbes& p, double u, double v, const TextureLevel& level, const Sampler& s) {
+[[gnu::noinline]] Texel probe_mean(const AnisoProbes& p, double u, double v, const TextureLevel& level, const Sampler& s) {
     const double step = 1.0 / p.count;
     if constexpr (kFilter == TexelFilter::linear) {
         // Bilinear quads at x = u·w − ½ + o·du·w: when both end quads lie inside the level (so do
@@ -318,7 +318,7 @@ Texel probe_mean(const AnisoProbes& p, double u, double v, const TextureLevel& l
     return first + difference * splat(static_cast<float>(step));
 }
 
-Texel anisotropic(const TextureView& t, double u, double v, const Footprint& f, glm::vec2 dx, glm::vec2 dy,
+[[gnu::noinline]] Texel anisotropic(const TextureView& t, double u, double v, const Footprint& f, glm::vec2 dx, glm::vec2 dy,
                   const Sampler& s) {
     const AnisoProbes p = aniso_probes(f, dx, dy, s, t.level_count());
     if (p.magnifies) return texel_filter(t.level(0), u, v, s.mag_filter, s);
@@ -354,7 +354,7 @@ const GaussianTable kGaussian;
 // Heckbert's EWA: the pixel's footprint ellipse (covariance J·Jᵀ of the screen → texel map,
 // the minor axis widened to 1/max_anisotropy of the major and to one texel of the chosen
 // level), weighted by a Gaussian of the screen distance, summed over the texels inside.
-Texel ewa(const TextureView& t, double u, double v, const Footprint& f, const Sampler& s) {
+[[gnu::noinline]] Texel ewa(const TextureView& t, double u, double v, const Footprint& f, const Sampler& s) {
     const int levels = t.level_count();
     if (isotropic_lod(f, s, levels) <= 0.0) return texel_filter(t.level(0), u, v, s.mag_filter, s);
     if (!f.finite()) return bilinear(t.level(levels - 1), u, v, s);
@@ -436,7 +436,7 @@ Texel ewa(const TextureView& t, double u, double v, const Footprint& f, const Sa
 
 // The notes' summed-area table: the exact mean over the bounding box of the pixel's footprint
 // parallelogram (the texture taken piecewise constant), on the table's level.
-Texel summed_area(const TextureView& t, double u, double v, const Footprint& f, const Sampler& s) {
+[[gnu::noinline]] Texel summed_area(const TextureView& t, double u, double v, const Footprint& f, const Sampler& s) {
     const int levels = t.level_count();
     const double lambda = isotropic_lod(f, s, levels);
     if (lambda <= 0.0) return texel_filter(t.level(0), u, v, s.mag_filter, s);
@@ -472,6 +472,11 @@ glm::vec4 sample_texture(const TextureView& t, const Sampler& s, glm::vec2 uv, g
     // One filter on level 0 whatever λ is: no need to compute it.
     if (!s.needs_derivatives()) return to_vec4(texel_filter(t.level(0), u, v, s.mag_filter, s));
     const Footprint f = texel_footprint(t, dx, dy);
+    // Plain magnification reads level 0 with the magnification filter for every footprint filter
+    // (what each of them decides on its own below): checked once here, it skips their setup.
+    // Both lengths are tested, so a NaN in either is not taken for magnification.
+    if (f.length2_y() <= 1.0 && plainly_magnifies(f.length2_x(), s))
+        return to_vec4(texel_filter(t.level(0), u, v, s.mag_filter, s));
     switch (s.footprint) {
         case FootprintFilter::isotropic: return to_vec4(isotropic(t, u, v, isotropic_lod(f, s, t.level_count()), s));
         case FootprintFilter::anisotropic: return to_vec4(anisotropic(t, u, v, f, dx, dy, s));
