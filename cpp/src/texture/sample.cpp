@@ -318,7 +318,7 @@ template <TexelFilter kFilter>
     return first + difference * splat(static_cast<float>(step));
 }
 
-[[gnu::noinline]] Texel anisotropic(const TextureView& t, double u, double v, const Footprint& f, glm::vec2 dx, glm::vec2 dy,
+Texel anisotropic(const TextureView& t, double u, double v, const Footprint& f, glm::vec2 dx, glm::vec2 dy,
                   const Sampler& s) {
     const AnisoProbes p = aniso_probes(f, dx, dy, s, t.level_count());
     if (p.magnifies) return texel_filter(t.level(0), u, v, s.mag_filter, s);
