@@ -129,11 +129,16 @@ inline Texel lerp_quad(Texel a, Texel b, Texel c, Texel d, float ax, float ay) {
 inline Texel bilinear(const TextureLevel& level, double u, double v, const Sampler& s) {
     const double x = reduce(u * level.width, level.width, s.wrap_u) - 0.5;
     const double y = reduce(v * level.height, level.height, s.wrap_v) - 0.5;
+    if (x >= 0.0 && y >= 0.0) {  // truncation is the floor: one dependent step less than floor_int
+        const int i = static_cast<int>(x), j = static_cast<int>(y);
+        if (i + 1 < level.width && j + 1 < level.height) {  // no wrapping: most lookups
+            const glm::vec4* row = &level.at(i, j);
+            return lerp_quad(load(row[0]), load(row[1]), load(row[level.width]), load(row[level.width + 1]),
+                             static_cast<float>(x - i), static_cast<float>(y - j));
+        }
+    }
     const int i = floor_int(x), j = floor_int(y);
-    const float ax = static_cast<float>(x - i), ay = static_cast<float>(y - j);
-    if (i < 0 || j < 0 || i + 1 >= level.width || j + 1 >= level.height) return bilinear_wrapped(level, i, j, ax, ay, s);
-    const glm::vec4* row = &level.at(i, j);  // no wrapping: most lookups
-    return lerp_quad(load(row[0]), load(row[1]), load(row[level.width]), load(row[level.width + 1]), ax, ay);
+    return bilinear_wrapped(level, i, j, static_cast<float>(x - i), static_cast<float>(y - j), s);
 }
 
 template <TexelFilter kFilter>
