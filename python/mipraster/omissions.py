@@ -136,9 +136,11 @@ def _checker(size: int) -> np.ndarray:
     return tex
 
 
-def ortho_textured(interpolation: str) -> Callable[[int, int], Dict[str, Any]]:
+def ortho_textured(force_division: bool) -> Callable[[int, int], Dict[str, Any]]:
     """Setup of a textured, vertex-coloured grid seen by an orthographic camera, uvs and colours
-    interpolated with `interpolation`."""
+    perspective-correct. Every clip w is 1, so the pipeline interpolates affinely; with
+    `force_division` the projection's w row gets a 1e-9·x term, so w differs between vertices
+    (by 1e-9: the same image) and every sample takes the division again."""
     def setup(width: int, height: int) -> Dict[str, Any]:
         import mipraster as mr
 
@@ -146,9 +148,15 @@ def ortho_textured(interpolation: str) -> Callable[[int, int], Dict[str, Any]]:
         positions = positions * np.float32([width / height, 1.0, 1.0])
         uvs = positions[:, :2] * 0.5 + 0.5
         scene = mr.Scene()
-        scene.add(mr.Mesh(positions, tris, colors=colors, uvs=uvs), interpolation=interpolation,
+        scene.add(mr.Mesh(positions, tris, colors=colors, uvs=uvs), interpolation="perspective",
                   texture=mr.Texture(_checker(256), srgb=False, name="checker"), sampler="trilinear")
-        return {"scene": scene, "camera": mr.Camera.orthographic((0, 0, 1), (0, 0, 0), height=2.0, near=0.5, far=2.0)}
+        camera = mr.Camera.orthographic((0, 0, 1), (0, 0, 0), height=2.0, near=0.5, far=2.0)
+        if force_division:
+            view, projection = camera.matrices(width, height)
+            projection = projection.copy()
+            projection[3, 0] = 1e-9
+            camera = mr.Camera.from_matrices(view, projection, depth_convention=camera.depth_convention)
+        return {"scene": scene, "camera": camera}
     return setup
 
 
@@ -186,10 +194,9 @@ OMISSIONS = [
              Variant("bilinear (no derivatives)", colour_grid("bilinear")),
              Variant("trilinear (derivatives and λ)", colour_grid("trilinear")), "exact"),
     Omission("no perspective division for orthographic cameras", "textured colour grid, orthographic camera",
-             Variant("interpolation='screen' (by hand)", ortho_textured("screen")),
-             Variant("interpolation='perspective' (the default)", ortho_textured("perspective")), "close",
-             "not automatic: the kernel follows the draw's interpolation, not the camera; with w = 1 both give "
-             "the same values"),
+             Variant("automatic: every clip w is 1, so perspective-correct is interpolated affinely",
+                     ortho_textured(force_division=False)),
+             Variant("w = 1 + 1e-9·x (the division per sample)", ortho_textured(force_division=True)), "close"),
     Omission("no resolve at 1 sample", "colour grid, 1 sample",
              Variant("tile writes straight into the image", colour_grid()),
              Variant("keep_samples: whole-frame sample buffer + resolve pass (+ samples returned)",

@@ -157,6 +157,55 @@ TEST(Interpolate, PerspectiveCorrectColoursMatchTheDoublePrecisionRayCast) {
     EXPECT_GT(checked, 20000u);
 }
 
+// Under an orthographic camera every vertex has clip w = 1, so the pipeline interpolates a
+// perspective-correct draw affinely (no division per sample): the colours of a strongly tilted
+// quad still match the ray cast.
+TEST(Interpolate, OrthographicPerspectiveDrawsMatchTheRayCastWithoutTheDivision) {
+    mr::Camera cam;
+    cam.view = mr::look_at({0.2, 0.1, 0.5}, {0.3, 0.0, -3.0}, {0.0, 1.0, 0.0});
+    cam.projection = mr::orthographic(-1.5, 1.5, -1.5, 1.5, 0.1, 20.0);
+    const oracle::RayCaster rc(cam.view, cam.projection, true, W, H);
+    const GridQuad quad = grid_quad(rc, {1.2, 6.0, 9.0});
+    const mr::RenderResult r = mr::render({make_draw(quad.mesh, glm::dmat4(1.0), shading(mr::Interpolation::perspective))},
+                                          cam, settings(W, H, 4, mr::PatternKind::grid));
+    const oracle::Pattern p = to_oracle(r.pattern);
+    std::array<glm::dvec3, 4> world;
+    for (int i = 0; i < 4; ++i) world[i] = glm::dvec3(quad.mesh.positions[i]);
+    std::size_t checked = 0, bad = 0;
+    for (const QuadSample& qs : covered_samples(quad, p)) {
+        if (qs.edge_distance < 1e-3) continue;
+        const glm::uvec3 t = quad.mesh.triangles[qs.triangle];
+        const oracle::Hit h = rc.intersect(rc.ray(qs.q.x / 256.0, qs.q.y / 256.0), world[t[0]], world[t[1]], world[t[2]]);
+        ASSERT_TRUE(h.hit);
+        const glm::vec4 got = sample_color(r.framebuffer, qs.x, qs.y, qs.s);
+        for (int c = 0; c < 3; ++c) {
+            const double exact = h.bary.x * kColors[t[0]][c] + h.bary.y * kColors[t[1]][c] + h.bary.z * kColors[t[2]][c];
+            if (std::fabs(got[c] - exact) > std::max(1e-5 * std::fabs(exact), 1e-6) && ++bad < 8)
+                ADD_FAILURE() << "pixel (" << qs.x << ", " << qs.y << ") channel " << c << ": got " << got[c]
+                              << ", ray cast " << exact;
+        }
+        ++checked;
+    }
+    EXPECT_EQ(bad, 0u);
+    EXPECT_GT(checked, 5000u);
+}
+
+// The choice itself: affine exactly when every clip w is the same number.
+TEST(Interpolate, PerspectiveBecomesAffineExactlyWhenEveryClipWIsEqual) {
+    using I = mr::Interpolation;
+    const std::vector<glm::dvec4> ortho = {{0, 0, 0, 1}, {1, 2, 3, 1}, {-4, 5, 0.5, 1}};
+    const std::vector<glm::dvec4> scaled = {{0, 0, 0, 2.5}, {1, 2, 3, 2.5}};
+    const std::vector<glm::dvec4> tilted = {{0, 0, 0, 1}, {1, 2, 3, 1}, {-4, 5, 0.5, 1.0000000000000002}};
+    const std::vector<glm::dvec4> nan_w = {{0, 0, 0, std::nan("")}, {1, 2, 3, std::nan("")}};
+    EXPECT_EQ(mr::effective_interpolation(I::perspective, ortho.data(), ortho.size()), I::screen);
+    EXPECT_EQ(mr::effective_interpolation(I::perspective, scaled.data(), scaled.size()), I::screen);
+    EXPECT_EQ(mr::effective_interpolation(I::perspective, tilted.data(), tilted.size()), I::perspective);
+    EXPECT_EQ(mr::effective_interpolation(I::perspective, nan_w.data(), nan_w.size()), I::perspective);
+    EXPECT_EQ(mr::effective_interpolation(I::perspective, ortho.data(), 0), I::perspective);
+    EXPECT_EQ(mr::effective_interpolation(I::flat, ortho.data(), ortho.size()), I::flat);
+    EXPECT_EQ(mr::effective_interpolation(I::screen, tilted.data(), tilted.size()), I::screen);
+}
+
 TEST(Interpolate, PerspectiveCorrectColoursMatchTheExactEdgeValueFormula) {
     // λ_i from exact integer edge values of the snapped triangle, then λ_i/w_i normalized.
     const mr::Camera cam = test_camera();

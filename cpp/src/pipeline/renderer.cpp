@@ -80,15 +80,16 @@ void validate_draws(const std::vector<Draw>& draws) {
     }
 }
 
-PipelineKey pipeline_key(const Draw& draw, const Camera& camera, const RenderSettings& settings) {
+PipelineKey pipeline_key(const Draw& draw, Interpolation interpolation, const Camera& camera,
+                         const RenderSettings& settings) {
     PipelineKey key;
     key.depth = !draw.state.depth_test ? DepthFunc::none
                 : camera.depth_convention == DepthConvention::opengl ? DepthFunc::less
                                                                      : DepthFunc::greater;
     key.blend = draw.state.blend;
     if (!draw.mesh->has_colors()) key.shading = Shading::constant;  // nothing to interpolate
-    else if (draw.state.interpolation == Interpolation::flat) key.shading = Shading::flat;
-    else if (draw.state.interpolation == Interpolation::screen) key.shading = Shading::screen;
+    else if (interpolation == Interpolation::flat) key.shading = Shading::flat;
+    else if (interpolation == Interpolation::screen) key.shading = Shading::screen;
     else key.shading = Shading::perspective;
     key.samples = settings.samples == 1 ? SampleMode::single
                   : settings.anti_aliasing == AntiAliasing::msaa ? SampleMode::msaa
@@ -396,7 +397,10 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     std::vector<DrawInputs> inputs(draws.size());
     std::vector<std::unique_ptr<TextureView>> textures(draws.size());  // pinned for the render
     for (std::size_t d = 0; d < draws.size(); ++d) {
-        kernels[d] = select_tile_kernel(pipeline_key(draws[d], camera, settings));
+        const ClipSpaceGeometry& g = geometry[d];
+        const Interpolation interpolation =
+            effective_interpolation(draws[d].state.interpolation, g.positions.data(), g.positions.size());
+        kernels[d] = select_tile_kernel(pipeline_key(draws[d], interpolation, camera, settings));
         const Mesh& mesh = *draws[d].mesh;
         inputs[d] = {mesh.triangles.data(), mesh.has_colors() ? mesh.colors.data() : nullptr, draws[d].color,
                      draws[d].state.depth_write};
@@ -405,7 +409,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             inputs[d].uvs = mesh.uvs.data();
             inputs[d].texture = textures[d].get();
             inputs[d].sampler = &draws[d].sampler;
-            inputs[d].uv_interpolation = draws[d].state.interpolation;
+            inputs[d].uv_interpolation = interpolation;
             inputs[d].derivatives = settings.derivatives;
             inputs[d].debug_view = settings.debug_view;
             if (settings.anti_aliasing == AntiAliasing::ssaa && S > 1)

@@ -2,12 +2,14 @@
 // Interpolation stage: barycentric weights of a sample from its exact edge values, in screen
 // space or perspective-correct, mapped back to the original (unclipped) triangle's vertices.
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 
 #include <glm/common.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "mipraster/pipeline/draw.hpp"
 #include "mipraster/pipeline/triangle_setup.hpp"
 
 namespace mipraster {
@@ -28,6 +30,19 @@ inline float sample_depth(const SetupTriangle& t, const glm::dvec3& l) {
 inline glm::dvec3 perspective_weights(const SetupTriangle& t, const glm::dvec3& l) {
     const glm::dvec3 q(l.x * t.inv_w[0], l.y * t.inv_w[1], l.z * t.inv_w[2]);
     return q * (1.0 / (q.x + q.y + q.z));
+}
+
+/// The interpolation the pipeline runs for a draw that asked for `requested`. Perspective-correct
+/// weights λ_i·q / Σ λ_j·q equal the screen weights λ_i when every vertex has the same clip w = 1/q
+/// (an orthographic camera), so such a draw interpolates affinely and skips a division per
+/// sample; the values differ by rounding only. Any other draw keeps what it asked for.
+inline Interpolation effective_interpolation(Interpolation requested, const glm::dvec4* clip_positions,
+                                             std::size_t count) {
+    if (requested != Interpolation::perspective || count == 0) return requested;
+    const double w = clip_positions[0].w;
+    for (std::size_t i = 1; i < count; ++i)
+        if (!(clip_positions[i].w == w)) return requested;
+    return w == w ? Interpolation::screen : requested;  // (a NaN w is never the same)
 }
 
 /// Maps weights of the setup triangle's vertices to weights of the original triangle's vertices
