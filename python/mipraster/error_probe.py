@@ -27,9 +27,10 @@ nothing at one sample per pixel. The probe says *how much*, for any scene and co
    spread of the n terms gives its standard error SE.
 4. Resolution: when the MSE is not 2 SE above zero and the reference's own squared error is
    larger than it (a very accurate render: the reference's noise hides its error), the passes
-   double, up to 16 (1024 samples per pixel), and the estimate is made again. If it is still not
-   resolved, the probe reports an upper bound, ``rmse`` = √(max(MSE, 0) + 2·SE) with
-   ``upper_bound`` True: the image's RMSE is at most that (one-sided, about 98 %).
+   double, up to 16 (1024 samples per pixel), and the estimate is made again. If the reference
+   still hides it, the probe reports an upper bound, ``rmse`` = √(max(MSE, 0) + 2·SE) with
+   ``upper_bound`` True: the image's RMSE is at most that (one-sided, about 98 %). An MSE that
+   is noisy only because few pixels were drawn stays a point estimate with its standard error.
 
 The cost is n pixels × K × 64 samples plus K setups of the scene, reported in ``ms``; by default
 n = W·H·S/(K·256) (a quarter of the render's samples) kept within [64, 1024].

@@ -1,6 +1,6 @@
 // The error probe (error_probe.hpp): its guide against hand-computed values; its estimate against
 // the hand-computed error of a render whose only error is one half-covered column; a flat image
-// gives an upper bound of zero without extra passes; an exact image whose error is below the
+// gives zero without extra passes; an exact image whose error is below the
 // reference's own makes the passes double and ends in an upper bound; bad input names itself.
 #include <gtest/gtest.h>
 
@@ -73,15 +73,16 @@ TEST(ErrorProbe, MeasuresAHalfCoveredColumn) {
     EXPECT_EQ(q.distinct_pixels, p.distinct_pixels);
 }
 
-TEST(ErrorProbe, FlatImageIsABoundOfZero) {
+TEST(ErrorProbe, FlatImageIsZeroWithoutExtraPasses) {
     const int w = 16, h = 16;
     const mr::Mesh m = pixel_mesh({{-1, -1}, {17, -1}, {17, 17}, {-1, -1}, {17, 17}, {-1, 17}});
     const mr::Draw d = make_draw(m, fixed_to_ndc(w, h), no_depth());
     const mr::RenderSettings s = settings(w, h, 4);
     const mr::RenderResult r = mr::render({d}, identity_camera(), s);
     const mr::ErrorProbe p = mr::measure_error({d}, identity_camera(), s, r.color, nullptr, 64, 3);
-    EXPECT_TRUE(p.upper_bound);
+    EXPECT_FALSE(p.upper_bound);  // the reference is exact too: nothing hides anything
     EXPECT_EQ(p.rmse, 0.0);
+    EXPECT_EQ(p.standard_error, 0.0);
     EXPECT_EQ(p.reference_spp, mr::kProbeReferenceSpp * mr::kProbeMinPasses);  // nothing to resolve: no more passes
 }
 

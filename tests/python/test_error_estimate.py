@@ -39,8 +39,8 @@ def test_flat_image_estimates_zero():
     assert r.error_map.shape == (30, 40)
     assert r.error_estimate < 1e-6  # the reference's 64 samples may round differently in the last bit
     assert np.all(r.error_map == 0.0)
-    # No error to resolve: the estimate says "at most", and the reference took no extra passes.
-    assert r.error_probe.upper_bound and "error_estimate<=" in repr(r)
+    # The reference is exact too: a point estimate, and no extra passes.
+    assert not r.error_probe.upper_bound and "error_estimate=" in repr(r)
     assert r.error_probe.reference_spp == 2 * _core.PROBE_REFERENCE_SPP
 
 

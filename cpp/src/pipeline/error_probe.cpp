@@ -211,12 +211,15 @@ ErrorProbe measure_error(const std::vector<Draw>& draws, const Camera& camera, c
         return e;
     };
 
-    // Step 4: more passes while the error is unresolved and the reference's own error is what hides it.
+    // Step 4: more passes while the error is unresolved and the reference's own error is what
+    // hides it (not the few pixels drawn: more passes would not help that).
     int passes = probe_reference_passes(settings.samples);
     add_passes(passes);
     Estimate e = estimate();
-    auto resolved = [](const Estimate& x) { return x.mse > kProbeResolvedStandardErrors * x.mse_se; };
-    while (!resolved(e) && passes < kProbeMaxPasses && e.reference_mse > std::max(e.mse, kProbeNegligibleMse)) {
+    auto hidden = [](const Estimate& x) {
+        return !(x.mse > kProbeResolvedStandardErrors * x.mse_se) && x.reference_mse > std::max(x.mse, kProbeNegligibleMse);
+    };
+    while (hidden(e) && passes < kProbeMaxPasses) {
         passes = std::min(kProbeMaxPasses, 2 * passes);
         add_passes(passes);
         e = estimate();
@@ -226,13 +229,14 @@ ErrorProbe measure_error(const std::vector<Draw>& draws, const Camera& camera, c
     probe.distinct_pixels = static_cast<int>(distinct.size());
     probe.reference_spp = kProbeReferenceSpp * passes;
     probe.reference_rmse = std::sqrt(std::max(0.0, e.reference_mse));
-    if (resolved(e)) {
-        probe.rmse = std::sqrt(e.mse);
-        probe.standard_error = e.mse_se / (2.0 * probe.rmse);  // the delta method
-    } else {
+    if (hidden(e)) {
         probe.upper_bound = true;
         probe.rmse = std::sqrt(std::max(e.mse, 0.0) + kProbeResolvedStandardErrors * e.mse_se);
         probe.standard_error = std::sqrt(e.mse_se);
+    } else {
+        probe.rmse = std::sqrt(std::max(e.mse, 0.0));
+        // The delta method where the RMSE is well above its noise; √(SE of the MSE) near 0.
+        probe.standard_error = probe.rmse > 0.0 && e.mse_se < e.mse ? e.mse_se / (2.0 * probe.rmse) : std::sqrt(e.mse_se);
     }
     probe.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return probe;

@@ -62,7 +62,8 @@ static_assert(kProbeMaxPasses >= 4 * kProbeMinPasses && kProbeMaxPasses % kProbe
 inline constexpr int kProbeMinPixels = 64, kProbeMaxPixels = 1024;
 static_assert(kProbeMinPixels >= 2 && kProbeMinPixels <= kProbeMaxPixels, "a spread needs 2 draws");
 /// The measured mean squared error counts as resolved when it is this many standard errors above 0
-/// (one-sided 97.7 % for a normal estimate); below it the probe reports an upper bound.
+/// (one-sided 97.7 % for a normal estimate); below it, where the reference's own error is larger,
+/// the probe adds passes and then reports an upper bound.
 inline constexpr double kProbeResolvedStandardErrors = 2.0;
 /// A mean squared error this small (RMSE 1e-5 in linear colour, far below an 8-bit step) needs no
 /// finer reference: the probe adds no passes to resolve it.

@@ -18,9 +18,11 @@
 // 3. d_i² = mean over R, G, B of (render_i − R_i)² − v_i² estimates the pixel's squared error
 //    without bias, MSE = (1/n)·Σ d_k²/(N·p_k) the image's; the terms' spread its standard error.
 // 4. Resolution. When the MSE is not kProbeResolvedStandardErrors standard errors above zero and
-//    the reference's own squared error is larger than it, the passes double (up to
-//    kProbeMaxPasses) and the estimate is made again. When it is still unresolved the probe
-//    reports an upper bound: rmse = √(max(MSE, 0) + 2·SE), upper_bound = true ("rmse < x").
+//    the reference's own squared error is larger than it (the reference's noise hides the
+//    render's error), the passes double (up to kProbeMaxPasses) and the estimate is made again.
+//    If the reference still hides it, the probe reports an upper bound: rmse = √(max(MSE, 0) +
+//    2·SE), upper_bound = true ("rmse <= x"). An MSE that is noisy only because few pixels were
+//    drawn stays a point estimate with its standard error (more passes would not help).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -36,7 +38,7 @@ namespace mipraster {
 struct ErrorProbe {
     double rmse = 0;            ///< estimated RMSE of the image (linear R, G, B); an upper bound when upper_bound
     double standard_error = 0;  ///< of rmse (delta method; √(SE of the MSE) when the MSE is near 0)
-    bool upper_bound = false;   ///< the error was not resolved: the image's RMSE is below rmse
+    bool upper_bound = false;   ///< the reference's own error hid the render's: its RMSE is at most rmse
     int pixels = 0;             ///< draws n (a pixel drawn twice counts twice)
     int distinct_pixels = 0;    ///< pixels rendered again
     int reference_spp = 0;      ///< samples per pixel of the reference (all passes)
