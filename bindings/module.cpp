@@ -6,6 +6,7 @@
 
 namespace mipraster::bindings {
 void bind_compare(pybind11::module_& m);  // compare.cpp
+void bind_error_probe(pybind11::module_& m);  // error_probe.cpp
 void bind_memory(pybind11::module_& m);   // memory.cpp
 void bind_texture(pybind11::module_& m);  // texture.cpp
 void bind_stress(pybind11::module_& m);   // stress.cpp
@@ -19,6 +20,7 @@ PYBIND11_MODULE(_core, m) {
     mipraster::bindings::bind_texture(m);
     mipraster::bindings::bind_scene(m);
     mipraster::bindings::bind_render(m);
+    mipraster::bindings::bind_error_probe(m);
     mipraster::bindings::bind_compare(m);
     mipraster::bindings::bind_stress(m);
     mipraster::bindings::bind_resample(m);

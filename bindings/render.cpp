@@ -21,6 +21,23 @@
 
 namespace mipraster::bindings {
 
+std::vector<Draw> core_draws(const py::sequence& draw_objects, std::vector<std::shared_ptr<Mesh>>& meshes) {
+    std::vector<Draw> draws;
+    meshes.reserve(meshes.size() + py::len(draw_objects));
+    draws.reserve(py::len(draw_objects));
+    std::size_t i = 0;
+    for (py::handle item : draw_objects) {
+        if (!py::isinstance<PyDraw>(item))
+            throw py::type_error("draws[" + std::to_string(i) + "]: expected mipraster._core.Draw, got " +
+                                 std::string(py::str(py::type::of(item).attr("__name__"))));
+        const PyDraw& d = item.cast<const PyDraw&>();
+        meshes.push_back(d.mesh);
+        draws.push_back(d.draw);
+        ++i;
+    }
+    return draws;
+}
+
 namespace {
 
 // Sample offsets from the pixel's top-left corner in pixels, (S, 2) float64 (exact: k/256).
@@ -58,19 +75,7 @@ py::dict stats_dict(const RenderStats& s) {
 // so nothing Python does meanwhile can free a mesh the renderer reads.
 py::dict render_py(const py::sequence& draw_objects, const Camera& camera, const RenderSettings& settings) {
     std::vector<std::shared_ptr<Mesh>> meshes;
-    std::vector<Draw> draws;
-    meshes.reserve(py::len(draw_objects));
-    draws.reserve(py::len(draw_objects));
-    std::size_t i = 0;
-    for (py::handle item : draw_objects) {
-        if (!py::isinstance<PyDraw>(item))
-            throw py::type_error("draws[" + std::to_string(i) + "]: expected mipraster._core.Draw, got " +
-                                 std::string(py::str(py::type::of(item).attr("__name__"))));
-        const PyDraw& d = item.cast<const PyDraw&>();
-        meshes.push_back(d.mesh);
-        draws.push_back(d.draw);
-        ++i;
-    }
+    const std::vector<Draw> draws = core_draws(draw_objects, meshes);
 
     RenderResult result;
     {

@@ -6,7 +6,8 @@
 //   mipraster render [SCENE] -o OUT.png [--camera N] [--size WxH] [--spp N] [--aa ssaa|msaa] [--pattern NAME]
 //                    [--look-at EX,EY,EZ,TX,TY,TZ] [--fov DEG] [--threads N]
 //                    [--filter F] [--max-aniso N] [--wrap W[,W]] [--lod-bias B] [--debug-view V]
-//                    [--derivatives analytic|quad] [--resolve F] [--memory-limit SIZE] [--stats] [--stats-json PATH] [--quiet]
+//                    [--derivatives analytic|quad] [--resolve F] [--memory-limit SIZE] [--stats] [--stats-json PATH]
+//                    [--error-map PATH] [--probe-pixels N] [--quiet]
 //   mipraster resize IN -o OUT --size WxH [--filter F] [--threads N] [--quiet]
 //   mipraster synthesize SAMPLE -o OUT --size WxH [--window N] [--seed S] [--epsilon E] [--periodic]
 //                        [--tileable] [--threads N] [--quiet]
@@ -35,6 +36,7 @@
 #include "mipraster/core/resample.hpp"
 #include "mipraster/io/image_io.hpp"
 #include "mipraster/io/scene_file.hpp"
+#include "mipraster/pipeline/error_probe.hpp"
 #include "mipraster/pipeline/renderer.hpp"
 #include "mipraster/scene/demo_scene.hpp"
 #include "mipraster/stress/stress_cases.hpp"
@@ -98,11 +100,15 @@ constexpr const char* kUsage =
     "  --derivatives D       analytic (exact per sample) or quad (2x2 finite differences) [analytic]\n"
     "  --resolve F           resolve filter: box (mean of the pixel's samples), tent, mitchell,\n"
     "                        catmull-rom, lanczos3 (also weigh the samples of nearby pixels) [box]\n"
-    "  --stats               print triangle, sample and per-stage time counts, and (spp >= 2)\n"
-    "                        the estimated RMSE from two interleaved halves of the samples\n"
+    "  --stats               print triangle, sample and per-stage time counts, and the estimated\n"
+    "                        RMSE: a probe renders some pixels again at reference quality (the\n"
+    "                        same estimate as Python's render(..., estimate_error=True))\n"
     "  --stats-json PATH     write the counts and times as JSON (- = stdout)\n"
-    "  --error-map PATH      write the per-pixel error estimate (RMS over linear R, G, B from two\n"
-    "                        interleaved halves of the samples; .exr linear, .png sRGB grey); spp >= 2\n"
+    "  --error-map PATH      write the per-pixel error estimate (RMS over linear R, G, B): two\n"
+    "                        interleaved halves of the samples, scaled to the probe's RMSE\n"
+    "                        (.exr linear, .png sRGB grey); spp >= 2\n"
+    "  --probe-pixels N      pixels the probe renders again; 0 = no probe (the raw halves\n"
+    "                        estimate, spp >= 2)   [W*H*spp/(256*K) within 64..1024, K passes]\n"
     "  --quiet               print nothing but errors (no summary, no progress bar)\n"
     "\n"
     "compare A B [options]: values are compared as read (linear float; 8-bit files are decoded\n"
@@ -204,6 +210,7 @@ struct RenderOptions {
     bool print_stats = false;
     std::string stats_json;  ///< path, "-" for stdout, empty for none
     std::string error_map;   ///< --error-map PATH: the per-pixel error estimate; empty for none
+    int probe_pixels = -1;   ///< --probe-pixels N; −1: default_probe_pixels, 0: no probe
     bool quiet = false;
     std::vector<double> look_at;  ///< empty: the demo's camera
     double fov_degrees = 0.0;     ///< 0: the demo's
@@ -317,6 +324,10 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
             o.stats_json = value();
         } else if (a == "--error-map") {
             o.error_map = value();
+        } else if (a == "--probe-pixels") {
+            o.probe_pixels = parse_int(a, value());
+            if (o.probe_pixels < 0)
+                throw UsageError("--probe-pixels: expected 0 (no probe) or a number of pixels, got " + args[i]);
         } else if (a == "--quiet") {
             o.quiet = true;
         } else if (!a.empty() && a[0] != '-' && o.scene.empty()) {
@@ -387,8 +398,22 @@ int run_render(const std::vector<std::string>& args) {
     if (sampler_flags && !o.quiet && std::none_of(draws.begin(), draws.end(), [](const Draw& d) { return bool(d.texture); }))
         std::fprintf(stderr, "mipraster: warning: the scene has no textured draw; the texture options change nothing\n");
     if (!o.quiet && isatty(STDOUT_FILENO)) settings.progress = draw_progress;
-    settings.estimate_error = (o.print_stats && settings.samples >= 2) || !o.error_map.empty();
-    const RenderResult result = render(draws, camera, settings);
+    // The estimate (--stats, --error-map): the halves map (spp >= 2) says where, the probe how much.
+    const bool estimate = o.print_stats || !o.error_map.empty();
+    const int probe_pixels = !estimate ? 0
+                             : o.probe_pixels >= 0 ? o.probe_pixels
+                                                   : default_probe_pixels(settings.width, settings.height, settings.samples);
+    settings.estimate_error = estimate && settings.samples >= 2;
+    RenderResult result = render(draws, camera, settings);
+    ErrorProbe probe;
+    if (probe_pixels > 0) {
+        probe = measure_error(draws, camera, settings, result.color, settings.estimate_error ? &result.error_map : nullptr,
+                              probe_pixels, settings.pattern_seed);
+        if (settings.estimate_error) {
+            calibrate_error_map(result.error_map, probe);
+            result.error_estimate = summarize_error_map(result.error_map);
+        }
+    }
     write_image(o.output, result.color);
     if (!o.quiet)
         std::printf("wrote %s (%dx%d, %d spp %s, %.1f ms on %d threads)\n", o.output.c_str(), settings.width,
@@ -397,12 +422,20 @@ int run_render(const std::vector<std::string>& args) {
     if (!o.error_map.empty()) write_image(o.error_map, result.error_map);
     if (o.print_stats) {
         std::printf("%s\n%s\n", result.pattern.to_string().c_str(), result.stats.to_string().c_str());
-        if (settings.estimate_error)
-            std::printf("error estimate (linear RGB, from two interleaved halves of the samples; sampling error "
-                        "only, not filter blur): rmse=%.6g, worst pixel=%.6g\n",
+        if (probe_pixels > 0) {
+            std::printf("error estimate (linear RGB; %d pixels rendered again at %d spp, %.1f ms): rmse%s%.6g "
+                        "+- %.2g, reference's own rmse=%.3g",
+                        probe.pixels, probe.reference_spp, probe.ms, probe.upper_bound ? "<=" : "=", probe.rmse,
+                        probe.standard_error, probe.reference_rmse);
+            if (settings.estimate_error) std::printf(", worst pixel=%.6g", result.error_estimate.max_pixel);
+            std::printf("%s\n", probe.upper_bound ? " (an upper bound: the error is too small for the probe to resolve)" : "");
+        } else if (settings.estimate_error) {
+            std::printf("error estimate (linear RGB, from two interleaved halves of the samples only; sampling "
+                        "error, not filter blur): rmse=%.6g, worst pixel=%.6g\n",
                         result.error_estimate.rmse, result.error_estimate.max_pixel);
-        else
-            std::printf("error estimate: needs --spp 2 or more\n");
+        } else {
+            std::printf("error estimate: without a probe (--probe-pixels 0) it needs --spp 2 or more\n");
+        }
     }
     if (o.stats_json == "-") {
         std::printf("%s\n", result.stats.to_json().c_str());

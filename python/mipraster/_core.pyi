@@ -215,6 +215,41 @@ def rasterize(pos_clip: _ArrayLike, triangles: _ArrayLike, settings: RasterizeSe
     """Keys: triangle_id (H, W, S) int32; barycentrics (H, W, S, 2) float32; depth (H, W, S) float32;
     pattern (S, 2) float64; pattern_kind str; stats dict."""
 
+# --- error probe (mipraster/pipeline/error_probe.hpp) ------------------------------------------
+
+PROBE_REFERENCE_SPP: int
+PROBE_MAX_PASSES: int
+
+class ErrorProbe:
+    """What the sparse reference measured (see mipraster.error_probe)."""
+    @property
+    def rmse(self) -> float:
+        """Estimated RMSE (linear R, G, B); an upper bound when upper_bound."""
+    @property
+    def stderr(self) -> float: ...
+    @property
+    def upper_bound(self) -> bool:
+        """True when the error was too small to resolve: the image's RMSE is at most rmse."""
+    @property
+    def pixels(self) -> int: ...
+    @property
+    def distinct_pixels(self) -> int: ...
+    @property
+    def reference_spp(self) -> int: ...
+    @property
+    def reference_rmse(self) -> float: ...
+    @property
+    def halves_rmse(self) -> Optional[float]: ...
+    @property
+    def ms(self) -> float: ...
+
+def measure_error(draws: List[Draw], camera: Camera, settings: RenderSettings, color: _ArrayLike,
+                  halves_map: Optional[_ArrayLike], pixels: int, seed: int = 0,
+                  guide: Optional[_ArrayLike] = None) -> ErrorProbe: ...
+def error_guide(color: _ArrayLike, halves_map: Optional[_ArrayLike] = None) -> npt.NDArray[np.float32]: ...
+def probe_reference_passes(spp: int) -> int: ...
+def default_probe_pixels(width: int, height: int, spp: int) -> int: ...
+
 # --- colour ------------------------------------------------------------------------------------
 
 def to_srgb8(image: _ArrayLike) -> npt.NDArray[np.uint8]: ...

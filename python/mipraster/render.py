@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import os
-from typing import Any, Dict, Optional, Union
+from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
 
@@ -48,11 +48,16 @@ class RenderResult:
             ``target_error``) with 2 or more samples per pixel, else None. It comes from the
             disagreement of two interleaved halves of each pixel's samples, scaled so that its
             root mean square is :attr:`error_estimate` (see :func:`render`).
-        error_estimate: the estimated RMSE of the whole image (linear R, G, B), or None.
+        error_estimate: the estimated RMSE of the whole image (linear R, G, B), or None. When
+            ``error_probe.upper_bound`` is True it is an upper bound: the error was too small for
+            the probe to resolve, and the image's RMSE is at most this.
         error_probe: the :class:`mipraster.error_probe.ErrorProbe` (the sparse reference's
-            measurement, its standard error and its cost), or None.
+            measurement, its standard error, whether it is an upper bound, and its cost), or None.
         pixel_spp: ``(H, W)`` int array of the samples each pixel got, for an adaptive render
             (``target_error``), else None.
+        adaptive: the passes of an adaptive render after the first, a list of
+            :class:`mipraster.adaptive.AdaptivePass` (each ``"refine"`` or ``"uniform"``, with the
+            cost model's prediction for both plans and the measured time), else None.
         stats: dict of the renderer's counters (``triangles_in``, ``triangles_clipped``,
             ``triangles_outside``, ``triangles_backface``, ``triangles_degenerate``,
             ``triangles_nonfinite``, ``triangles_rasterized``, ``samples_covered``,
@@ -61,7 +66,7 @@ class RenderResult:
     """
 
     __slots__ = ("color", "depth", "samples", "sample_depth", "pattern", "pattern_kind", "stats", "error_map",
-                 "error_estimate", "error_probe", "pixel_spp")
+                 "error_estimate", "error_probe", "pixel_spp", "adaptive")
 
     def __init__(self, raw: Dict[str, Any]) -> None:
         self.color: np.ndarray = raw["color"]
@@ -76,6 +81,7 @@ class RenderResult:
         self.error_estimate: Optional[float] = None if estimate is None else float(estimate)
         self.error_probe: Optional[Any] = raw.get("error_probe")
         self.pixel_spp: Optional[np.ndarray] = raw.get("pixel_spp")
+        self.adaptive: Optional[List[Any]] = raw.get("adaptive")
 
     @property
     def width(self) -> int:
@@ -109,7 +115,8 @@ class RenderResult:
     def __repr__(self) -> str:
         return (f"RenderResult({self.width}x{self.height}, spp={self.spp} {self.pattern_kind}, "
                 f"samples={'kept' if self.samples is not None else 'None'}, "
-                + (f"error_estimate={self.error_estimate:.4g}, " if self.error_estimate is not None else "")
+                + (f"error_estimate{'<=' if self.error_probe is not None and self.error_probe.upper_bound else '='}"
+                   f"{self.error_estimate:.4g}, " if self.error_estimate is not None else "")
                 + f"total_ms={self.stats['total_ms']:.3f})")
 
 
@@ -162,17 +169,23 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             rendered again at reference quality (2 or more passes of 64 stratified samples, SSAA,
             textures read at level 0 with bilinear) and their squared differences (less the
             reference's own error) give an unbiased estimate of the image's mean squared error,
-            for any scene and any ``spp`` (see :mod:`mipraster.error_probe`).
+            for any scene and any ``spp`` (see :mod:`mipraster.error_probe`); where the error is
+            too small to resolve against the reference's own, the reference gets more passes,
+            and if that is not enough the estimate is an upper bound (``error_probe.upper_bound``).
             ``error_estimate`` is the probe's RMSE, ``error_map`` the halves map scaled to it,
-            ``error_probe`` the probe's details (standard error, cost in ms).
+            ``error_probe`` the probe's details (standard error, cost in ms). The command line's
+            ``--stats`` and ``--error-map`` run the same probe and report the same numbers.
         target_error: adaptive quality: render at ``spp`` (at least 2) with the estimate, then
             give more samples (up to 64) to the pixels whose estimated error needs them, in one
             extra pass of just those pixels: the fewest samples that bring the image's estimated
             RMSE to ``target_error`` (an RMSE in linear colour) with error ∝ 1/√spp; repeated
             (at most 4 passes) while the estimate misses the target and some pixel with error
-            has fewer than 64; each round's error is a new probe of the image (see
-            :mod:`mipraster.adaptive`). ``stats['total_ms']`` is the time of all passes and probes;
-            ``pixel_spp`` shows where samples went. Needs the box resolve.
+            has fewer than 64; each round's error is a new probe of the image. While every pixel
+            has the same count, a cost model from measured per-sample times weighs that pass
+            against a uniform render of every pixel at the samples predicted to meet the target,
+            and the cheaper one is rendered (see :mod:`mipraster.adaptive`).
+            ``stats['total_ms']`` is the time of all passes and probes; ``pixel_spp`` shows where
+            samples went, ``adaptive`` which plan each pass took. Needs the box resolve.
         probe_pixels: pixels the probe renders again (``estimate_error`` / ``target_error``):
             None = W·H·spp/(256·K) within [64, 1024] with K reference passes (2, or 4 at 64 spp):
             a quarter of the render's samples; 0 = no probe (the raw halves estimate; needs
@@ -238,21 +251,21 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     if target_error is not None:
         from .adaptive import render_adaptive_settings
 
-        return render_adaptive_settings(scene, draws, core_camera, settings, target_error, n_probe)
+        return render_adaptive_settings(draws, core_camera, settings, target_error, n_probe)
     raw = _core.render(draws, core_camera, settings)
     if estimate and n_probe > 0:
-        _calibrate(raw, scene, core_camera, settings, n_probe)
+        _calibrate(raw, draws, core_camera, settings, n_probe)
     return RenderResult(raw)
 
 
-def _calibrate(raw: Dict[str, Any], scene: Scene, core_camera: Any, settings: Any, n_probe: int) -> None:
+def _calibrate(raw: Dict[str, Any], draws: Any, core_camera: Any, settings: Any, n_probe: int) -> None:
     """Measures the error of the core render ``raw`` with a probe of ``n_probe`` pixels (see
     :mod:`mipraster.error_probe`) and puts it into ``raw``: ``error_estimate`` becomes the probe's
     RMSE and ``error_map`` (when there is one and it is not zero everywhere) the halves map scaled
     to it."""
     from .error_probe import measure_error
 
-    probe = measure_error(scene, core_camera, settings, raw["color"], raw.get("error_map"), n_probe,
+    probe = measure_error(draws, core_camera, settings, raw["color"], raw.get("error_map"), n_probe,
                           seed=settings.pattern_seed)
     raw["error_probe"], raw["error_estimate"] = probe, probe.rmse
     if raw.get("error_map") is not None and probe.halves_rmse:

@@ -89,6 +89,7 @@ class StudyRow:
     estimate_ratio: float = float("nan")
     estimate_stderr: float = float("nan")  # the probe's standard error
     estimate_ms: float = float("nan")  # the probe's cost (all threads), next to ms_all_threads
+    estimate_bound: bool = False  # the estimate is an upper bound (the probe could not resolve the error)
     target_error: float = float("nan")
     mean_spp: float = float("nan")
     notes: str = ""
@@ -180,10 +181,15 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
             row.estimate = result.error_estimate
             if result.error_probe is not None:
                 row.estimate_stderr = result.error_probe.stderr
+                row.estimate_bound = result.error_probe.upper_bound
+            row.notes = "passes: " + ", ".join(
+                f"{p.kind} {p.pixels} px at {p.samples}x (model {p.predicted_ms:.3g} ms against "
+                f"{p.alternative_ms:.3g} ms)" for p in result.adaptive) if result.adaptive else "no pass after the first"
         else:
             probed = render(scene, s.camera, s.width, s.height, estimate_error=True, **kwargs)
             row.estimate = probed.error_estimate
             row.estimate_stderr, row.estimate_ms = probed.error_probe.stderr, probed.error_probe.ms
+            row.estimate_bound = probed.error_probe.upper_bound
         if not math.isnan(row.estimate) and row.rmse > 0:
             row.estimate_ratio = row.estimate / row.rmse
         rows.append(row)
@@ -199,15 +205,16 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
     for row, t in zip(rows, times):
         row.ms_one_thread, row.ms_all_threads = statistics.median(t[1]), statistics.median(t[threads])
         log(f"  {row.label:36s} {row.ms_one_thread:8.2f} ms x1 {row.ms_all_threads:8.2f} ms xN  rmse {row.rmse:.4g}"
-            + (f"  est/true {row.estimate_ratio:.2f}" if not math.isnan(row.estimate_ratio) else ""))
+            + (f"  est/true {row.estimate_ratio:.2f}" if not math.isnan(row.estimate_ratio) else "")
+            + (" (upper bound)" if row.estimate_bound else ""))
     for row in rows:
         if row.renderer == "mipraster adaptive":
             uniform = _uniform_time_for_error(rows, s.name, row.rmse)
             if uniform is None:
-                row.notes = "uniform SSAA up to 64x does not reach this error"
+                row.notes += "; uniform SSAA up to 64x does not reach this error"
             else:
-                row.notes = (f"uniform SSAA needs {uniform:.2f} ms (one thread) for this error: "
-                             f"{100 * (1 - row.ms_one_thread / uniform):.0f}% saved")
+                row.notes += (f"; uniform SSAA needs {uniform:.2f} ms (one thread) for this error: "
+                              f"{100 * (1 - row.ms_one_thread / uniform):.0f}% saved")
     return rows
 
 
@@ -254,6 +261,13 @@ def _fmt(v: float, digits: int = 3) -> str:
     return "–" if isinstance(v, float) and math.isnan(v) else f"{v:.{digits}g}"
 
 
+def _estimate_text(r: StudyRow) -> str:
+    """The estimate as the table prints it: "x ± se", or "≤ x" for an upper bound."""
+    if r.estimate_bound:
+        return f"≤ {_fmt(r.estimate)}"
+    return f"{_fmt(r.estimate)} ± {_fmt(r.estimate_stderr, 2)}"
+
+
 def markdown(rows: Sequence[StudyRow], notes: Sequence[str]) -> str:
     """The study as Markdown: a table per scene, then the estimate calibration and adaptive savings."""
     out = ["# Error against run time", ""] + [f"- {n}" for n in notes] + [""]
@@ -266,11 +280,13 @@ def markdown(rows: Sequence[StudyRow], notes: Sequence[str]) -> str:
         for i, r in enumerate(rs):
             label = r.label + (f" (mean {r.mean_spp:.1f} spp)" if not math.isnan(r.mean_spp) else "")
             out.append(f"| {label} | {r.filter} | {r.ms_one_thread:.2f} | {r.ms_all_threads:.2f} | {r.rmse:.4g} | "
-                       f"{r.mean_abs:.4g} | {r.max_abs:.3g} | {_fmt(r.estimate)} ± {_fmt(r.estimate_stderr, 2)} | "
+                       f"{r.mean_abs:.4g} | {r.max_abs:.3g} | {_estimate_text(r)} | "
                        f"{_fmt(r.estimate_ratio, 2)} | "
                        f"{'●' if i in front else ''} |")
         out.append("")
-    ratios = [r for r in rows if not math.isnan(r.estimate_ratio) and r.renderer == "mipraster"]
+    ratios = [r for r in rows if not math.isnan(r.estimate_ratio) and r.renderer == "mipraster"
+              and not r.estimate_bound]
+    bounds = [r for r in rows if r.estimate_bound and r.renderer == "mipraster" and not math.isnan(r.estimate)]
     if ratios:
         inside = [r for r in ratios if 0.5 <= r.estimate_ratio <= 2.0]
         # Where the reference's own error is more than half the measured one, the measured RMSE is
@@ -278,7 +294,7 @@ def markdown(rows: Sequence[StudyRow], notes: Sequence[str]) -> str:
         judged = [r for r in ratios if r.reference_residual <= 0.5 * r.rmse]
         judged_inside = [r for r in judged if r in inside]
         worst = max(ratios, key=lambda r: abs(math.log(r.estimate_ratio)) if r.estimate_ratio > 0 else math.inf)
-        costs = [r.estimate_ms / r.ms_all_threads for r in ratios
+        costs = [r.estimate_ms / r.ms_all_threads for r in ratios + bounds
                  if not math.isnan(r.estimate_ms) and r.ms_all_threads > 0]
         out += ["## Error estimate calibration", "",
                 f"estimate / true RMSE within a factor of 2 on {len(inside)} of {len(ratios)} configurations "
@@ -287,6 +303,14 @@ def markdown(rows: Sequence[StudyRow], notes: Sequence[str]) -> str:
                 f"{worst.scene} {worst.label}: {worst.estimate_ratio:.2f}); on {len(judged_inside)} of the "
                 f"{len(judged)} whose reference's own error is at most half the measured RMSE (the others' "
                 f"measured RMSE is mostly the reference's).", ""]
+        if bounds:
+            held = [r for r in bounds if r.rmse <= r.estimate]
+            out += [f"Upper bounds (the probe could not resolve the error even with more reference passes, "
+                    f"and says the RMSE is at most the figure): {len(bounds)} configuration(s), not counted "
+                    f"above; the bound holds (true RMSE ≤ bound) on {len(held)} of them: "
+                    + "; ".join(f"{r.scene} {r.label}: true {r.rmse:.2g} ≤ {r.estimate:.2g}"
+                                if r in held else f"{r.scene} {r.label}: true {r.rmse:.2g} > {r.estimate:.2g} (FAILS)"
+                                for r in bounds) + ".", ""]
         if costs:
             out += [f"The probe costs {statistics.median(costs):.2f}× the render's time (median; "
                     f"{min(costs):.2f}–{max(costs):.2f}×, all threads).", ""]
@@ -300,7 +324,7 @@ def markdown(rows: Sequence[StudyRow], notes: Sequence[str]) -> str:
     adaptive = [r for r in rows if r.renderer == "mipraster adaptive"]
     if adaptive:
         out += ["## Adaptive quality", ""]
-        out += [f"- {r.scene} {r.label}: target {r.target_error:.3g}, estimate {_fmt(r.estimate)}, true RMSE "
+        out += [f"- {r.scene} {r.label}: target {r.target_error:.3g}, estimate {_estimate_text(r)}, true RMSE "
                 f"{r.rmse:.4g}, {r.ms_one_thread:.2f} ms (one thread), mean {r.mean_spp:.1f} spp; {r.notes}" for r in adaptive]
         out.append("")
     return "\n".join(out)

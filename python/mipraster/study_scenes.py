@@ -76,6 +76,24 @@ def _pixel_camera(width: int, height: int) -> Camera:
                                height=float(height), near=0.0, far=2.0)
 
 
+def _flat_scene(name: str, tri_xy: np.ndarray, colours: np.ndarray, width: int, height: int) -> StudyScene:
+    """Flat-coloured triangles given in pixel coordinates (``tri_xy`` (T, 3, 2), ``colours`` (T, 3)
+    linear RGB), drawn in order over a dark background through :func:`_pixel_camera`; reference:
+    their exact coverage."""
+    positions = np.concatenate([tri_xy[..., 0:1], -tri_xy[..., 1:2], np.zeros(tri_xy.shape[:2] + (1,))], axis=2)
+    mesh = Mesh(positions.reshape(-1, 3), np.arange(3 * len(tri_xy)).reshape(-1, 3),
+                colors=np.repeat(colours, 3, axis=0))
+    scene = Scene()
+    scene.add(mesh, depth_test=False, interpolation="flat")
+    clear = (0.02, 0.02, 0.05, 1.0)
+    scene.clear_color = clear
+
+    def reference(quality: float = 1.0) -> Tuple[np.ndarray, float, str]:
+        return exact_coverage(tri_xy, colours, width, height, clear[:3]), 0.0, "exact coverage"
+
+    return StudyScene(name, scene, _pixel_camera(width, height), width, height, clear, reference)
+
+
 def star(width: int = 160, height: int = 120, spikes: int = 24) -> StudyScene:
     """Thin triangles from the centre (a star) and two thin bars drawn over it, flat colours."""
     cx, cy, radius = width / 2, height / 2, 0.47 * min(width, height)
@@ -94,20 +112,7 @@ def star(width: int = 160, height: int = 120, spikes: int = 24) -> StudyScene:
              (cx + dx * length - nx, cy + dy * length - ny), (cx - dx * length - nx, cy - dy * length - ny)]
         tris += [[p[0], p[1], p[2]], [p[0], p[2], p[3]]]
         cols += [colour, colour]
-    tri_xy = np.array(tris, dtype=np.float64)
-    colours = np.array(cols, dtype=np.float64)
-    positions = np.concatenate([tri_xy[..., 0:1], -tri_xy[..., 1:2], np.zeros(tri_xy.shape[:2] + (1,))], axis=2)
-    mesh = Mesh(positions.reshape(-1, 3), np.arange(3 * len(tris)).reshape(-1, 3),
-                colors=np.repeat(colours, 3, axis=0))
-    scene = Scene()
-    scene.add(mesh, depth_test=False, interpolation="flat")
-    clear = (0.02, 0.02, 0.05, 1.0)
-    scene.clear_color = clear
-
-    def reference(quality: float = 1.0) -> Tuple[np.ndarray, float, str]:
-        return exact_coverage(tri_xy, colours, width, height, clear[:3]), 0.0, "exact coverage"
-
-    return StudyScene("star", scene, _pixel_camera(width, height), width, height, clear, reference)
+    return _flat_scene("star", np.array(tris, dtype=np.float64), np.array(cols, dtype=np.float64), width, height)
 
 
 def shapes(width: int = 160, height: int = 120) -> StudyScene:
@@ -122,19 +127,7 @@ def shapes(width: int = 160, height: int = 120) -> StudyScene:
         [(0.70, 0.60), (0.93, 0.93), (0.62, 0.97)],
     ]
     colours = np.array([(0.9, 0.3, 0.1), (0.1, 0.5, 0.9), (0.2, 0.8, 0.3), (0.95, 0.85, 0.2), (0.8, 0.2, 0.7)])
-    tri_xy = np.array(corners, dtype=np.float64) * [width, height]
-    positions = np.concatenate([tri_xy[..., 0:1], -tri_xy[..., 1:2], np.zeros(tri_xy.shape[:2] + (1,))], axis=2)
-    mesh = Mesh(positions.reshape(-1, 3), np.arange(3 * len(corners)).reshape(-1, 3),
-                colors=np.repeat(colours, 3, axis=0))
-    scene = Scene()
-    scene.add(mesh, depth_test=False, interpolation="flat")
-    clear = (0.02, 0.02, 0.05, 1.0)
-    scene.clear_color = clear
-
-    def reference(quality: float = 1.0) -> Tuple[np.ndarray, float, str]:
-        return exact_coverage(tri_xy, colours, width, height, clear[:3]), 0.0, "exact coverage"
-
-    return StudyScene("shapes", scene, _pixel_camera(width, height), width, height, clear, reference)
+    return _flat_scene("shapes", np.array(corners, dtype=np.float64) * [width, height], colours, width, height)
 
 
 def _plane_scene(name: str, plane: TexturedPlane, view: PerspectiveView, sampler: Sampler, width: int, height: int,

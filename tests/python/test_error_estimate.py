@@ -8,7 +8,7 @@ import pytest
 
 import mipraster as mr
 from mipraster import _core
-from mipraster.adaptive import MAX_PASSES, plan_refinement
+from mipraster.adaptive import MAX_PASSES, plan_refinement, uniform_samples
 from mipraster.error_probe import default_pixel_count, guide
 from mipraster.reference import exact_coverage, image_error
 from mipraster.study_scenes import checker_plane, shapes, star, with_filter, zone_plate
@@ -39,6 +39,9 @@ def test_flat_image_estimates_zero():
     assert r.error_map.shape == (30, 40)
     assert r.error_estimate < 1e-6  # the reference's 64 samples may round differently in the last bit
     assert np.all(r.error_map == 0.0)
+    # The reference is exact too: a point estimate, and no extra passes.
+    assert not r.error_probe.upper_bound and "error_estimate=" in repr(r)
+    assert r.error_probe.reference_spp == 2 * _core.PROBE_REFERENCE_SPP
 
 
 def test_estimate_is_half_the_disagreement_of_the_halves():
@@ -85,6 +88,7 @@ def test_probe_calibration(make, spp, aa, filt):
     assert residual < 0.25 * true
     assert 0.5 <= r.error_estimate / true <= 2.0, (r.error_estimate, true, r.error_probe)
     assert r.error_probe.pixels == default_pixel_count(64, 48, spp)
+    assert not r.error_probe.upper_bound  # errors well above the reference's own are resolved
     assert 0 < r.error_probe.stderr < r.error_estimate
     if r.error_map is not None and r.error_probe.halves_rmse > 0:  # the map is scaled to the estimate
         assert math.sqrt(np.mean(r.error_map.astype(np.float64) ** 2)) == pytest.approx(r.error_estimate, rel=1e-5)
@@ -199,6 +203,46 @@ def test_plan_is_the_cheapest_single_pass():
             assert mask.sum() * s == best, (trial, mask, s, best)
 
 
+def test_uniform_samples_is_the_fewest_that_meet_the_target():
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        spp = int(rng.choice([1, 2, 4, 8, 16, 32, 64]))
+        error = float(rng.uniform(0.001, 0.1))
+        target = error * float(rng.uniform(0.05, 1.2))
+        got = uniform_samples(error, spp, target)
+        if spp == 64:
+            assert got is None
+            continue
+        meets = [s for s in range(spp + 1, 65) if (s == 64 or s % spp == 0 and (s // spp) & (s // spp - 1) == 0)
+                 and error * math.sqrt(spp / s) <= target]
+        assert got == (min(meets) if meets else 64), (spp, error, target, got)
+
+
+@pytest.mark.parametrize("make, kind", [(zone_plate, "uniform"), (None, "refine")])
+def test_adaptive_takes_the_cheaper_plan(make, kind):
+    # Error everywhere (the zone plate): refining most pixels as listed pixels costs more than a
+    # uniform render, so adaptive renders every pixel again and says so. Error in a few pixels
+    # (one small triangle): refining them is cheaper. Each pass took the plan the cost model
+    # (measured per-sample times) priced lower.
+    if make is None:
+        scene, camera, _ = _corner_triangle(96, 64)
+    else:
+        s = make(96, 64)
+        scene, camera = s.scene, s.camera
+    base = mr.render(scene, camera, 96, 64, spp=4, estimate_error=True)
+    r = mr.render(scene, camera, 96, 64, spp=4, target_error=0.5 * base.error_estimate)
+    assert r.adaptive and r.adaptive[0].kind == kind, r.adaptive
+    for p in r.adaptive:
+        assert p.predicted_ms <= p.alternative_ms and p.ms > 0 and not math.isnan(p.error)
+        assert p.kind in repr(p)
+    refined = int(np.sum(r.pixel_spp > 4))
+    if kind == "uniform":
+        assert r.adaptive[0].pixels == 96 * 64 and r.pixel_spp.min() >= r.adaptive[0].samples
+    else:
+        assert refined <= sum(p.pixels for p in r.adaptive) and refined < 0.2 * 96 * 64
+    assert r.adaptive[-1].error == r.error_estimate
+
+
 def test_adaptive_bad_input():
     s = star(32, 32)
     for bad in (0.0, -1.0, float("nan"), float("inf")):
@@ -236,34 +280,71 @@ def test_tile_mask_size_is_checked():
         _core.render([d._draw for d in s.scene.draws], s.camera.build(40, 40), settings)
 
 
-def test_cli_stats_prints_the_estimate(tmp_path):
+def _cli_estimate(stdout):
+    line = [l for l in stdout.splitlines() if l.startswith("error estimate")][0]
+    bound = "rmse<=" in line
+    value = float(line.split("rmse<=" if bound else "rmse=")[1].split(" ")[0].rstrip(","))
+    return line, value, bound
+
+
+@pytest.mark.parametrize("spp, aa", [(8, "msaa"), (1, "ssaa")])
+def test_cli_stats_reports_the_calibrated_estimate(tmp_path, spp, aa):
+    # The CLI's --stats runs the same probe as render(..., estimate_error=True) on the same demo
+    # render: the same estimate (printed to 6 digits), at 1 spp too.
     from test_cli import EXE
     import subprocess
 
-    r = subprocess.run([EXE, "render", "-o", str(tmp_path / "a.png"), "--size", "64x36", "--spp", "8", "--stats"],
-                       capture_output=True, text=True, timeout=120)
+    r = subprocess.run([EXE, "render", "-o", str(tmp_path / "a.png"), "--size", "64x36", "--spp", str(spp), "--aa", aa,
+                        "--stats"], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
-    line = [l for l in r.stdout.splitlines() if l.startswith("error estimate")][0]
-    assert float(line.split("rmse=")[1].split(",")[0]) > 0  # the demo has edges
-    r = subprocess.run([EXE, "render", "-o", str(tmp_path / "b.png"), "--size", "64x36", "--spp", "1", "--stats"],
+    line, value, bound = _cli_estimate(r.stdout)
+    scene, camera = mr.Scene.demo()
+    py = mr.render(scene, camera, 64, 36, spp=spp, aa=aa, estimate_error=True)
+    assert value == pytest.approx(py.error_estimate, rel=1e-5) and bound == py.error_probe.upper_bound
+    assert value > 0  # the demo has edges
+    assert f"{py.error_probe.pixels} pixels rendered again at {py.error_probe.reference_spp} spp" in line
+    assert ("worst pixel=" in line) == (spp >= 2)
+
+
+def test_cli_stats_without_probe(tmp_path):
+    # --probe-pixels 0: the raw halves estimate (needs 2 samples), as render(..., probe_pixels=0).
+    from test_cli import EXE
+    import subprocess
+
+    r = subprocess.run([EXE, "render", "-o", str(tmp_path / "a.png"), "--size", "64x36", "--spp", "8", "--stats",
+                        "--probe-pixels", "0"], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    line, value, _ = _cli_estimate(r.stdout)
+    scene, camera = mr.Scene.demo()
+    py = mr.render(scene, camera, 64, 36, spp=8, aa="msaa", estimate_error=True, probe_pixels=0)
+    assert "two interleaved halves" in line and value == pytest.approx(py.error_estimate, rel=1e-5)
+    r = subprocess.run([EXE, "render", "-o", str(tmp_path / "b.png"), "--size", "64x36", "--spp", "1", "--stats",
+                        "--probe-pixels", "0"], capture_output=True, text=True, timeout=120)
+    assert "error estimate: without a probe (--probe-pixels 0) it needs --spp 2 or more" in r.stdout
+    r = subprocess.run([EXE, "render", "-o", str(tmp_path / "b.png"), "--probe-pixels", "-3"],
                        capture_output=True, text=True, timeout=120)
-    assert "error estimate: needs --spp 2 or more" in r.stdout
+    assert r.returncode == 2 and "--probe-pixels: expected 0 (no probe) or a number of pixels" in r.stderr
 
 
-def test_cli_error_map(tmp_path):
-    # The map the CLI writes is the one render(..., estimate_error=True) returns for the same demo.
+@pytest.mark.parametrize("probe_pixels", [None, 0])
+def test_cli_error_map(tmp_path, probe_pixels):
+    # The map the CLI writes is the one render(..., estimate_error=True) returns for the same demo:
+    # the halves map scaled to the probe's estimate, or with --probe-pixels 0 the raw halves map.
     from test_cli import EXE
     import subprocess
 
     out = tmp_path / "err.exr"
+    extra = [] if probe_pixels is None else ["--probe-pixels", str(probe_pixels)]
     r = subprocess.run([EXE, "render", "-o", str(tmp_path / "a.png"), "--size", "64x36", "--spp", "8", "--aa", "ssaa",
-                        "--error-map", str(out), "--quiet"], capture_output=True, text=True, timeout=120)
+                        "--error-map", str(out), "--quiet", *extra], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
-    written = mr.read_image(out)
+    written = np.asarray(mr.read_image(out)).reshape(36, 64, -1)[..., 0]
     scene, camera = mr.Scene.demo()
-    expected = mr.render(scene, camera, 64, 36, spp=8, aa="ssaa", estimate_error=True, probe_pixels=0).error_map
-    np.testing.assert_allclose(np.asarray(written).reshape(36, 64, -1)[..., 0], expected, atol=1e-6)
-    assert expected.max() > 0
+    expected = mr.render(scene, camera, 64, 36, spp=8, aa="ssaa", estimate_error=True, probe_pixels=probe_pixels)
+    np.testing.assert_allclose(written, expected.error_map, rtol=1e-6, atol=1e-9)
+    assert expected.error_map.max() > 0
+    if probe_pixels is None:
+        assert math.sqrt(np.mean(written.astype(np.float64) ** 2)) == pytest.approx(expected.error_estimate, rel=1e-4)
     r = subprocess.run([EXE, "render", "-o", str(tmp_path / "b.png"), "--spp", "1", "--error-map", str(out)],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and "--error-map" in r.stderr and "--spp 2" in r.stderr

@@ -49,6 +49,25 @@ def test_tiny_study_end_to_end(tmp_path):
     assert any("reference" in line for line in logs)
 
 
+def _row(label, rmse, estimate, bound=False, residual=0.0):
+    r = st.StudyRow("s", label, "mipraster", 1, "center", "ssaa", "-", 1.0, 0.0, 1.0, 1.0, 2, rmse, rmse, rmse,
+                    residual, estimate=estimate, estimate_ratio=estimate / rmse, estimate_stderr=0.1 * estimate,
+                    estimate_ms=0.5, estimate_bound=bound)
+    return r
+
+
+def test_calibration_counts_upper_bounds_apart():
+    # Point estimates are judged by the factor of 2; upper bounds are listed apart and judged by
+    # whether they hold (true RMSE <= bound), and the table prints them as "≤ x".
+    rows = [_row("1x", 0.10, 0.12), _row("4x", 0.05, 0.2), _row("16x", 0.001, 0.004, bound=True),
+            _row("64x", 0.003, 0.002, bound=True)]
+    md = st.markdown(rows, [])
+    assert "within a factor of 2 on 1 of 2 configurations" in md
+    assert "Upper bounds" in md and "2 configuration(s), not counted above; the bound holds (true RMSE ≤ bound) on 1 of them" in md
+    assert "s 16x: true 0.001 ≤ 0.004" in md and "s 64x: true 0.003 > 0.002 (FAILS)" in md
+    assert "| ≤ 0.004 |" in md and "| 0.12 ± 0.012 |" in md
+
+
 def test_plot_is_optional(tmp_path, monkeypatch):
     rows = [st.StudyRow("s", "1x", "mipraster", 1, "center", "ssaa", "-", 1.0, 0.0, 1.0, 1.0, 2, 0.1, 0.05, 0.3, 0.0)]
     monkeypatch.setitem(sys.modules, "matplotlib", None)  # as if it were not installed

@@ -47,4 +47,27 @@ static_assert(kProjectedAreaRoundingUlps >= 4.0 && kProjectedAreaRoundingUlps <=
 /// Most threads a render may ask for.
 inline constexpr int kMaxThreads = 256;
 
+/// Error probe (error_probe.hpp): samples per pixel of one reference pass, the most a pass gives.
+inline constexpr int kProbeReferenceSpp = kMaxSamples;
+/// Reference passes at least: two independent passes are the fewest whose disagreement measures
+/// the reference's own error.
+inline constexpr int kProbeMinPasses = 2;
+/// Reference passes at most (1024 samples per pixel): the probe doubles its passes while the
+/// error it measures is unresolved and smaller than its reference's own; 8× its first cost at worst.
+inline constexpr int kProbeMaxPasses = 16;
+static_assert(kProbeMaxPasses >= 4 * kProbeMinPasses && kProbeMaxPasses % kProbeMinPasses == 0,
+              "room to double the passes at least twice");
+/// Pixels a probe renders by default at least and at most: enough draws to find sparse edges, a
+/// bounded cost on large images.
+inline constexpr int kProbeMinPixels = 64, kProbeMaxPixels = 1024;
+static_assert(kProbeMinPixels >= 2 && kProbeMinPixels <= kProbeMaxPixels, "a spread needs 2 draws");
+/// The measured mean squared error counts as resolved when it is this many standard errors above 0
+/// (one-sided 97.7 % for a normal estimate); below it, where the reference's own error is larger,
+/// the probe adds passes and then reports an upper bound.
+inline constexpr double kProbeResolvedStandardErrors = 2.0;
+/// A mean squared error this small (RMSE 1e-5 in linear colour, far below an 8-bit step) needs no
+/// finer reference: the probe adds no passes to resolve it.
+inline constexpr double kProbeNegligibleMse = 1e-10;
+static_assert(kProbeNegligibleMse > 0.0 && kProbeNegligibleMse < 1e-8, "below any visible error");
+
 }  // namespace mipraster
