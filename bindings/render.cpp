@@ -63,6 +63,7 @@ py::dict stats_dict(const RenderStats& s) {
     d["samples_covered"] = s.samples_covered;
     d["samples_passed"] = s.samples_passed;
     d["shader_invocations"] = s.shader_invocations;
+    d["depth_blocks_rejected"] = s.depth_blocks_rejected;
     d["threads"] = s.threads;
     d["transform_ms"] = s.transform_ms;
     d["setup_ms"] = s.setup_ms;

@@ -33,6 +33,7 @@
 
 #include "mipraster/texture/sample.hpp"
 #include "mipraster/texture/sampler.hpp"
+#include "cli_options.hpp"
 #include "mipraster/texture/texture.hpp"
 
 namespace {
@@ -170,19 +171,9 @@ std::string json_passes(const Passes& p) {
     return s + "]}";
 }
 
-int usage_error(const std::string& message) {
-    std::fprintf(stderr, "mipraster_bench_roofline: %s\n\n%s", message.c_str(), kUsage);
-    return 2;
-}
+int usage_error(const std::string& message) { return mipraster::apps::usage_error("mipraster_bench_roofline", message, kUsage); }
 
-bool parse_count(const char* text, long long lo, long long& out) {
-    char* end = nullptr;
-    errno = 0;
-    const long long v = std::strtoll(text, &end, 10);
-    if (errno || end == text || *end != '\0' || v < lo) return false;
-    out = v;
-    return true;
-}
+using mipraster::apps::parse_count;
 
 int run(int argc, char** argv) {
     std::string out_json;

@@ -41,6 +41,7 @@
 
 #include "mipraster/texture/sample.hpp"
 #include "mipraster/texture/sampler.hpp"
+#include "cli_options.hpp"
 #include "mipraster/texture/texture.hpp"
 
 namespace {
@@ -251,19 +252,9 @@ std::vector<std::string> split_list(const char* text) {
     return items;
 }
 
-int usage_error(const std::string& message) {
-    std::fprintf(stderr, "mipraster_bench_texture: %s\n\n%s", message.c_str(), kUsage);
-    return 2;
-}
+int usage_error(const std::string& message) { return mipraster::apps::usage_error("mipraster_bench_texture", message, kUsage); }
 
-bool parse_count(const char* text, long long lo, long long& out) {
-    char* end = nullptr;
-    errno = 0;
-    const long long v = std::strtoll(text, &end, 10);
-    if (errno || end == text || *end != '\0' || v < lo) return false;
-    out = v;
-    return true;
-}
+using mipraster::apps::parse_count;
 
 int run(int argc, char** argv) {
     std::string out_json, out_md;

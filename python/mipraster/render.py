@@ -61,7 +61,7 @@ class RenderResult:
         stats: dict of the renderer's counters (``triangles_in``, ``triangles_clipped``,
             ``triangles_outside``, ``triangles_backface``, ``triangles_degenerate``,
             ``triangles_nonfinite``, ``triangles_rasterized``, ``samples_covered``,
-            ``samples_passed``, ``shader_invocations``, ``threads``) and times in milliseconds
+            ``samples_passed``, ``shader_invocations``, ``depth_blocks_rejected``, ``threads``) and times in milliseconds
             (``transform_ms``, ``setup_ms``, ``raster_ms``, ``total_ms``).
     """
 

@@ -142,7 +142,7 @@ def test_stats_and_repr():
     assert set(result.stats) == {
         "triangles_in", "triangles_clipped", "triangles_outside", "triangles_backface", "triangles_degenerate",
         "triangles_nonfinite", "triangles_rasterized", "samples_covered", "samples_passed",
-        "shader_invocations", "threads", "transform_ms", "setup_ms", "raster_ms", "total_ms"}
+        "shader_invocations", "depth_blocks_rejected", "threads", "transform_ms", "setup_ms", "raster_ms", "total_ms"}
     assert result.stats["triangles_in"] == sum(d.mesh.triangle_count for d in scene.draws)
     assert result.stats["threads"] == 2
     assert (result.width, result.height, result.spp, result.pattern_kind) == (32, 18, 1, "center")
@@ -289,3 +289,26 @@ def test_render_refuses_wrong_types(args, kwargs, words):
 def test_numpy_integers_are_accepted_for_sizes():
     result = mr.render(one_draw_scene(), screen_camera(), np.int64(W), np.int32(H), spp=np.uint8(4))
     assert result.color.shape == (H, W, 4) and result.spp == 4
+
+
+def test_depth_blocks_behind_an_occluder_drawn_first_are_skipped_and_the_image_is_unchanged():
+    def screen_quad(z, color):
+        positions = [(x - W / 2, H / 2 - y, z) for x, y in [(0, 0), (W, 0), (W, H), (0, H)]]
+        return mr.Mesh(positions, [[0, 1, 2], [0, 2, 3]], [color] * 4)
+
+    occluder = screen_quad(1.0, (0.2, 0.4, 0.6, 1.0))
+    behind = [screen_quad(-1.0 + 0.05 * i, (0.9, 0.1 * i, 0.0, 1.0)) for i in range(10)]  # each nearer
+    front_first, back_first = mr.Scene(), mr.Scene()
+    for mesh in [occluder] + behind:
+        front_first.add(mesh)
+    for mesh in behind + [occluder]:
+        back_first.add(mesh)
+    a = mr.render(front_first, screen_camera(), W, H, spp=4, threads=1)
+    b = mr.render(back_first, screen_camera(), W, H, spp=4, threads=2)
+    # 10 full-screen quads behind, each 2 triangles over 3 x 2 blocks of 8 x 8 pixels (W x H = 24 x 16),
+    # each block fully inside one triangle or shared by both.
+    assert a.stats["depth_blocks_rejected"] > 0
+    assert b.stats["depth_blocks_rejected"] == 0  # every quad is nearer than what it covers
+    assert a.stats["samples_covered"] == b.stats["samples_covered"] == 11 * W * H * 4
+    assert a.stats["samples_passed"] == W * H * 4
+    np.testing.assert_array_equal(a.color, b.color)

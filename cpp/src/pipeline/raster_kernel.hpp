@@ -11,6 +11,7 @@
 #include "mipraster/pipeline/rasterize_tile.hpp"
 #include "mipraster/pipeline/shade_texture.hpp"
 #include "mipraster/texture/sample.hpp"
+#include "tile_blocks.hpp"
 
 namespace mipraster {
 namespace kernels {
@@ -71,12 +72,20 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     const SamplePattern& pattern = *target.pattern;
     const int S = kMode == SampleMode::single ? 1 : pattern.count();
     constexpr std::int64_t kStep = kSubpixelOne;  // one pixel in fixed point
+    TileBlocks blocks(target, S);
 
     for (std::size_t k = 0; k < batch.count; ++k) {
         const SetupTriangle& t = batch.tris[batch.indices[k]];
         const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
         const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
         if (x0 >= x1 || y0 >= y1) continue;
+        // Blocks with nothing to do, and blocks whose depth tests would all fail (tile_blocks.hpp).
+        BlockClasses cls;
+        if (target.block_skipping) {
+            cls = blocks.classify<kDepth>(t, x0, y0, x1, y1, S);
+            counters.samples_covered += cls.skipped_samples;
+            counters.depth_blocks_rejected += static_cast<std::uint64_t>(cls.depth_rejected);
+        }
 
         // The vertex colours of the original triangle, once per triangle and tile.
         VertexValues colors;
@@ -97,12 +106,15 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         const std::int64_t step0 = t.edge_a[0] * kStep, step1 = t.edge_a[1] * kStep, step2 = t.edge_a[2] * kStep;
 
         for (int py = y0; py < y1; ++py) {
-            // Edge values at the top-left corner of pixel (x0, py), exact in int64.
-            const std::int64_t X = std::int64_t{x0} * kStep, Y = std::int64_t{py} * kStep;
+            int rx0 = x0, rx1 = x1;  // the row without skipped blocks at its ends
+            blocks.trim(cls.skipped, py, rx0, rx1);
+            if (rx0 >= rx1) continue;
+            // Edge values at the top-left corner of pixel (rx0, py), exact in int64.
+            const std::int64_t X = std::int64_t{rx0} * kStep, Y = std::int64_t{py} * kStep;
             const std::int64_t row0 = t.edge_a[0] * X + t.edge_b[0] * Y + t.edge_c[0];
             const std::int64_t row1 = t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1];
             const std::int64_t row2 = t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2];
-            const int n = x1 - x0;
+            const int n = rx1 - rx0;
 
             // Coverage masks of the row: sample s of pixel j is inside iff all three edge values are
             // ≥ 0, i.e. the sign bit of their OR is clear. Plain integer adds: this loop vectorizes on
@@ -123,7 +135,12 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             for (int j = 0; j < n; ++j) {
                 std::uint64_t covered = mask[j];
                 if (!covered) continue;
-                const int px = x0 + j;
+                const int px = rx0 + j;
+                if ((cls.skipped | cls.hidden) >> blocks.bit(px, py) & 1) {  // counted, not tested
+                    if (cls.hidden >> blocks.bit(px, py) & 1)
+                        counters.samples_covered += static_cast<std::uint64_t>(__builtin_popcountll(covered));
+                    continue;
+                }
                 const std::int64_t p0 = row0 + j * step0, p1 = row1 + j * step1, p2 = row2 + j * step2;
                 float* const color_px = kShading == Shading::visibility ? nullptr : color_out.at(px, py, 0);
                 float* const depth_px = kDepth != DepthFunc::none ? depth_out.at(px, py, 0) : nullptr;
@@ -143,6 +160,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         passed |= std::uint64_t{1} << s;
                     }
                     if (!passed) continue;
+                    if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
                     counters.samples_passed += static_cast<std::uint64_t>(__builtin_popcountll(passed));
                     ++counters.shader_invocations;
                     glm::vec4 color;
@@ -180,6 +198,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             const float z = sample_depth(t, l);
                             if (!depth_passes<kDepth>(z, depth_px[s])) continue;
                             if (draw.depth_write) depth_px[s] = z;
+                            blocks.written(px, py);
                         }
                         ++counters.samples_passed;
                         if constexpr (kShading == Shading::visibility) {

@@ -240,6 +240,7 @@ void add_counters(const std::vector<TileCounters>& tiles, RenderStats& stats) {
         stats.samples_covered += c.samples_covered;
         stats.samples_passed += c.samples_passed;
         stats.shader_invocations += c.shader_invocations;
+        stats.depth_blocks_rejected += c.depth_blocks_rejected;
     }
 }
 
@@ -423,6 +424,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     std::size_t tiles_done = 0;
     pool.parallel_for(static_cast<std::size_t>(grid.count()), [&](std::size_t tile) {
         TileTarget target = tile_target(grid, tile, result.pattern);
+        target.block_skipping = settings.block_skipping;
         const bool masked = !settings.tile_mask.empty() && !settings.tile_mask[tile];
         if (masked || listed) {
             // Pixels not asked for: the clear colour, no samples drawn, no error.
@@ -590,7 +592,7 @@ std::string RenderSettings::to_string() const {
            mipraster::to_string(anti_aliasing) + ", threads=" + std::to_string(threads) + ", resolve=" +
            mipraster::to_string(resolve_filter) + ", derivatives=" + mipraster::to_string(derivatives) +
            ", debug_view=" + mipraster::to_string(debug_view) +
-           (estimate_error ? ", estimate_error" : "") +
+           (estimate_error ? ", estimate_error" : "") + (block_skipping ? "" : ", no block skipping") +
            (tile_mask.empty() ? "" : ", tile_mask=" + std::to_string(tile_mask.size()) + " tiles") +
            (pixels.empty() ? "" : ", pixels=" + std::to_string(pixels.size())) + ")";
 }
@@ -612,7 +614,7 @@ std::string RenderStats::to_json() const {
            field("triangles_degenerate", triangles_degenerate) + field("triangles_nonfinite", triangles_nonfinite) +
            field("triangles_rasterized", triangles_rasterized) + field("samples_covered", samples_covered) +
            field("samples_passed", samples_passed) + field("shader_invocations", shader_invocations) +
-           field("threads", threads) + field("transform_ms", transform_ms) + field("setup_ms", setup_ms) +
+           field("depth_blocks_rejected", depth_blocks_rejected) + field("threads", threads) + field("transform_ms", transform_ms) + field("setup_ms", setup_ms) +
            field("raster_ms", raster_ms) + field("total_ms", total_ms, true) + "}";
 }
 
@@ -627,7 +629,8 @@ std::string RenderStats::to_string() const {
            ", degenerate=" + std::to_string(triangles_degenerate) + ", nonfinite=" + std::to_string(triangles_nonfinite) +
            ", rasterized=" + std::to_string(triangles_rasterized) + ", samples_covered=" + std::to_string(samples_covered) +
            ", samples_passed=" + std::to_string(samples_passed) + ", shader_invocations=" +
-           std::to_string(shader_invocations) + ", threads=" + std::to_string(threads) + ", transform_ms=" +
+           std::to_string(shader_invocations) + ", depth_blocks_rejected=" + std::to_string(depth_blocks_rejected) +
+           ", threads=" + std::to_string(threads) + ", transform_ms=" +
            ms(transform_ms) + ", setup_ms=" + ms(setup_ms) + ", raster_ms=" + ms(raster_ms) +
            ", total_ms=" + ms(total_ms) + ")";
 }

@@ -46,6 +46,9 @@ struct TileTarget {
     /// and the weights of its 2nd and 3rd vertex (a 2-channel window).
     std::int32_t* triangle_ids = nullptr;
     SampleWindow barycentrics;
+    /// Per 8×8-pixel block, skip the samples a triangle cannot cover and the depth tests it would
+    /// fail everywhere (the output is the same either way; false runs the plain per-sample path).
+    bool block_skipping = true;
 };
 
 /// Per-draw inputs of the kernel.
@@ -79,6 +82,7 @@ struct TileCounters {
     std::uint64_t samples_covered = 0;  ///< samples inside a triangle
     std::uint64_t samples_passed = 0;   ///< of those, passed the depth test
     std::uint64_t shader_invocations = 0;
+    std::uint64_t depth_blocks_rejected = 0;  ///< (triangle, 8×8 block) pairs whose depth tests were skipped
 };
 
 using TileKernel = void (*)(const TileTarget&, const DrawInputs&, const TriangleBatch&, TileCounters&);

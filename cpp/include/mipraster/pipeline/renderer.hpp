@@ -55,6 +55,10 @@ struct RenderSettings {
     /// the scene (a sparse reference and per-pixel refinement render few pixels with many
     /// samples). Not with tile_mask, nor with a resolve filter wider than a pixel.
     std::vector<std::uint32_t> pixels;
+    /// Per 8×8-pixel block, skip a triangle's samples where it covers none, and its depth tests
+    /// where it lies behind every depth already stored (they would all fail). The output and the
+    /// sample counters are the same either way; false runs the plain per-sample path, for comparison.
+    bool block_skipping = true;
     /// Called as tiles finish with (tiles done, tiles in all); calls are serialized (never
     /// concurrent) but may come from any worker thread. Empty: no progress reports.
     std::function<void(std::size_t, std::size_t)> progress;
@@ -73,7 +77,12 @@ struct RenderStats {
     std::uint64_t triangles_degenerate = 0;///< zero area after snapping
     std::uint64_t triangles_nonfinite = 0; ///< non-finite after transform (e.g. a degenerate matrix): dropped
     std::uint64_t triangles_rasterized = 0;///< set-up (sub-)triangles sent to the rasterizer
+    /// Samples inside a drawn triangle (whether or not their depth test ran: see
+    /// depth_blocks_rejected), of those the ones that passed the depth test, and colour shader runs.
     std::uint64_t samples_covered = 0, samples_passed = 0, shader_invocations = 0;
+    /// (triangle, 8×8-pixel block) pairs whose depth tests were skipped because the triangle lies
+    /// behind every depth stored in the block (RenderSettings::block_skipping).
+    std::uint64_t depth_blocks_rejected = 0;
     int threads = 1;
     double transform_ms = 0, setup_ms = 0;
     double raster_ms = 0;  ///< clear, rasterize, shade, test, blend and resolve, tile by tile

@@ -1,0 +1,194 @@
+#pragma once
+// What a triangle needs in each 8×8-pixel block of a tile (private to the pipeline): nothing where
+// it covers no sample; no depth test where it lies behind every depth stored there (each test would
+// fail, and a failed test changes nothing); nothing at all where both hold for all its samples
+// (their count is known without them). The output is unchanged bit for bit, counters included.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "mipraster/core/constants.hpp"
+#include "mipraster/pipeline/framebuffer.hpp"
+#include "mipraster/pipeline/rasterize_tile.hpp"
+#include "mipraster/pipeline/triangle_setup.hpp"
+
+namespace mipraster {
+namespace kernels {
+
+/// Pixels per side of a block: small enough to follow the edges of triangles and of the surfaces in
+/// front, large enough that a block's bounds cost little next to the samples they save.
+inline constexpr int kBlockShift = 3;
+inline constexpr int kBlock = 1 << kBlockShift;
+static_assert(kTileSize % kBlock == 0, "blocks must tile a tile");
+inline constexpr int kBlocksPerSide = kTileSize / kBlock;
+static_assert(kBlocksPerSide * kBlocksPerSide <= 32, "one bit per block of a tile in a uint32");
+
+/// A triangle classifies a block only where its bounding box covers at least this many of the
+/// block's pixels: a small triangle pays more for the bounds than the few samples they could skip.
+inline constexpr int kBlockMinPixels = 16;
+static_assert(kBlockMinPixels >= 1 && kBlockMinPixels <= kBlock * kBlock, "a pixel count");
+
+/// Relative margin of the depth-plane bound: far above the ~1e-15 relative rounding of
+/// sample_depth's double arithmetic, far below float depth's 6e-8 resolution.
+inline constexpr double kDepthBoundMargin = 1e-9;
+static_assert(kDepthBoundMargin > 1e-14 && kDepthBoundMargin < 1e-8, "between double and float resolution");
+
+enum class BlockCoverage { none, some, all };
+
+/// The positions, in 1/256 px, of the samples of a rectangle of pixels: X0 ≤ X ≤ X1, Y0 ≤ Y ≤ Y1.
+struct SampleExtent {
+    std::int64_t X0, Y0, X1, Y1;
+};
+
+/// Whether t covers no sample, some or all samples inside the extent. Edge values are affine, so
+/// their extremes over the extent are at its corners; exact in int64.
+inline BlockCoverage block_coverage(const SetupTriangle& t, const SampleExtent& r) {
+    const std::int64_t X[2] = {r.X0, r.X1}, Y[2] = {r.Y0, r.Y1};
+    bool all = true;
+    for (int i = 0; i < 3; ++i) {
+        std::int64_t lo = std::numeric_limits<std::int64_t>::max(), hi = std::numeric_limits<std::int64_t>::min();
+        for (int corner = 0; corner < 4; ++corner) {
+            const std::int64_t e = t.edge_a[i] * X[corner & 1] + t.edge_b[i] * Y[corner >> 1] + t.edge_c[i];
+            lo = std::min(lo, e);
+            hi = std::max(hi, e);
+        }
+        if (hi < 0) return BlockCoverage::none;
+        if (lo < 0) all = false;
+    }
+    return all ? BlockCoverage::all : BlockCoverage::some;
+}
+
+/// A float that no sample of t inside the extent has a nearer depth than (sample_depth is ≤ it for
+/// greater, ≥ it for less). Depth is affine in the screen position, so the plane's extremes over
+/// the extent are at its corners; the margin covers rounding, and rounding to float is monotonic.
+/// A NaN anywhere makes the bound NaN, which rejects nothing.
+template <DepthFunc kDepth>
+float nearest_depth(const SetupTriangle& t, const SampleExtent& r) {
+    constexpr bool kGreater = kDepth == DepthFunc::greater;
+    double nearest = kGreater ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
+    double reach = 1.0;  // the largest weight magnitude involved, for the margin
+    for (int corner = 0; corner < 4; ++corner) {
+        const std::int64_t X = corner & 1 ? r.X1 : r.X0, Y = corner & 2 ? r.Y1 : r.Y0;
+        const double l1 = static_cast<double>(t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1] + t.bias[1]) * t.inv_area2;
+        const double l2 = static_cast<double>(t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2] + t.bias[2]) * t.inv_area2;
+        const double z = t.z0 + l1 * t.dz1 + l2 * t.dz2;
+        if (kGreater ? !(z <= nearest) : !(z >= nearest)) nearest = z;  // keeps a NaN
+        reach = std::max({reach, std::abs(l1), std::abs(l2)});
+    }
+    const double margin = kDepthBoundMargin * (std::abs(t.z0) + 2.0 * reach * (std::abs(t.dz1) + std::abs(t.dz2)));
+    return static_cast<float>(kGreater ? nearest + margin : nearest - margin);
+}
+
+/// What one triangle needs in the blocks of its bounding box, one bit per block (TileBlocks::bit).
+struct BlockClasses {
+    std::uint32_t skipped = 0;  ///< no per-pixel work: covers no sample, or covers all and is hidden
+    std::uint32_t hidden = 0;   ///< covers some samples, all behind the stored depths: coverage only
+    std::uint64_t skipped_samples = 0;  ///< covered samples of the skipped blocks
+    int depth_rejected = 0;             ///< blocks, skipped or hidden, that are behind the stored depths
+};
+
+/// The blocks of one tile target and the farthest depth stored in each, computed when a triangle
+/// first asks and again after a depth write into the block (depth only moves nearer, so a bound
+/// computed before later writes stays valid, only looser).
+class TileBlocks {
+public:
+    /// For a target whose pixels hold the first S samples of its pattern.
+    TileBlocks(const TileTarget& target, int S)
+        : target_(target), bx0_(target.x0 >> kBlockShift), by0_(target.y0 >> kBlockShift) {
+        const auto& x = target.pattern->x;
+        const auto& y = target.pattern->y;
+        ox0_ = *std::min_element(x.begin(), x.begin() + S);
+        ox1_ = *std::max_element(x.begin(), x.begin() + S);
+        oy0_ = *std::min_element(y.begin(), y.begin() + S);
+        oy1_ = *std::max_element(y.begin(), y.begin() + S);
+    }
+
+    /// Bit of the block holding pixel (x, y).
+    int bit(int x, int y) const { return ((y >> kBlockShift) - by0_) * kBlocksPerSide + (x >> kBlockShift) - bx0_; }
+    /// After a depth write at pixel (x, y).
+    void written(int x, int y) { known_ &= ~(std::uint32_t{1} << bit(x, y)); }
+
+    /// Narrows the pixels [x0, x1) of row y to leave out skipped blocks at either end.
+    void trim(std::uint32_t skipped, int y, int& x0, int& x1) const {
+        if (!skipped) return;
+        while (x0 < x1 && (skipped >> bit(x0, y) & 1)) x0 = ((x0 >> kBlockShift) + 1) << kBlockShift;
+        while (x0 < x1 && (skipped >> bit(x1 - 1, y) & 1)) x1 = ((x1 - 1) >> kBlockShift) << kBlockShift;
+    }
+
+    /// Classifies the blocks of t's bounding box [x0, x1) × [y0, y1) (clipped to the target) with
+    /// S samples per pixel; kDepth none tests coverage only.
+    template <DepthFunc kDepth>
+    BlockClasses classify(const SetupTriangle& t, int x0, int y0, int x1, int y1, int S) {
+        BlockClasses out;
+        for (int by = y0 >> kBlockShift; by <= (y1 - 1) >> kBlockShift; ++by) {
+            const int ry0 = std::max(y0, by << kBlockShift), ry1 = std::min(y1, (by + 1) << kBlockShift);
+            for (int bx = x0 >> kBlockShift; bx <= (x1 - 1) >> kBlockShift; ++bx) {
+                const int rx0 = std::max(x0, bx << kBlockShift), rx1 = std::min(x1, (bx + 1) << kBlockShift);
+                const int pixels = (rx1 - rx0) * (ry1 - ry0);
+                if (pixels < kBlockMinPixels) continue;
+                const std::uint32_t m = std::uint32_t{1} << ((by - by0_) * kBlocksPerSide + bx - bx0_);
+                // Where the samples of the pixels [rx0, rx1) × [ry0, ry1) lie.
+                const SampleExtent r{std::int64_t{rx0} * kSubpixelOne + ox0_, std::int64_t{ry0} * kSubpixelOne + oy0_,
+                                     std::int64_t{rx1 - 1} * kSubpixelOne + ox1_, std::int64_t{ry1 - 1} * kSubpixelOne + oy1_};
+                const BlockCoverage coverage = block_coverage(t, r);
+                if (coverage == BlockCoverage::none) {
+                    out.skipped |= m;
+                    continue;
+                }
+                if constexpr (kDepth != DepthFunc::none) {
+                    if (!hidden<kDepth>(t, m, r)) continue;
+                    ++out.depth_rejected;
+                    if (coverage == BlockCoverage::some) {
+                        out.hidden |= m;
+                    } else {
+                        out.skipped |= m;
+                        out.skipped_samples += static_cast<std::uint64_t>(pixels) * static_cast<std::uint64_t>(S);
+                    }
+                }
+            }
+        }
+        return out;
+    }
+
+private:
+    // Whether every sample of t inside the extent (in block m) fails the depth test:
+    // its z is at most (at least) `nearest` and every stored depth at least (at most) the block's
+    // farthest, so z > stored (z < stored) cannot hold.
+    template <DepthFunc kDepth>
+    bool hidden(const SetupTriangle& t, std::uint32_t m, const SampleExtent& r) {
+        const int b = __builtin_ctz(m);
+        if (!(known_ & m)) {
+            farthest_[b] = farthest_stored<kDepth>(b);
+            known_ |= m;
+        }
+        const float nearest = nearest_depth<kDepth>(t, r);
+        return kDepth == DepthFunc::greater ? nearest <= farthest_[b] : nearest >= farthest_[b];
+    }
+
+    // The farthest stored depth of block b within the target: the smallest for greater, the
+    // largest for less (stored depths are never NaN: a NaN never passes the test).
+    template <DepthFunc kDepth>
+    float farthest_stored(int b) const {
+        const int bx = bx0_ + b % kBlocksPerSide, by = by0_ + b / kBlocksPerSide;
+        const SampleWindow& depth = target_.depth;
+        const int x0 = std::max(target_.x0, bx << kBlockShift), x1 = std::min(target_.x1, (bx + 1) << kBlockShift);
+        const int y0 = std::max(target_.y0, by << kBlockShift), y1 = std::min(target_.y1, (by + 1) << kBlockShift);
+        float f = *depth.at(x0, y0, 0);
+        for (int y = y0; y < y1; ++y) {
+            const float* p = depth.at(x0, y, 0);
+            const float* const end = depth.at(x1 - 1, y, depth.samples - 1) + 1;
+            for (; p != end; ++p) f = kDepth == DepthFunc::greater ? std::min(f, *p) : std::max(f, *p);
+        }
+        return f;
+    }
+
+    const TileTarget& target_;
+    int bx0_, by0_;
+    std::int32_t ox0_, ox1_, oy0_, oy1_;  ///< the extremes of the sample offsets, in 1/256 px
+    std::uint32_t known_ = 0;  ///< blocks whose farthest_ is current
+    float farthest_[kBlocksPerSide * kBlocksPerSide];
+};
+
+}  // namespace kernels
+}  // namespace mipraster

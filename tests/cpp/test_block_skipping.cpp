@@ -1,0 +1,157 @@
+// Block skipping (raster kernel, tile_blocks.hpp): leaving out the 8×8 blocks a triangle does not
+// cover and the depth tests of the blocks it cannot win in changes nothing — colour, depth and
+// sample counters are bit for bit those of the plain per-sample path for every depth convention,
+// blend, sample mode and thread count — and it does skip blocks where a surface in front hides the rest.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "helpers.hpp"
+
+namespace {
+
+namespace mr = mipraster;
+using namespace helpers;
+
+/// `n` large random triangles in the box [−2, 2]×[−1.5, 1.5]×[−2, 6] (the cameras below look from
+/// z = 4, so some cross the near plane), tilted so their depth varies across them, in random depth
+/// order, with premultiplied vertex colours.
+mr::Mesh random_overlap(std::size_t n, double size, std::uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    mr::Mesh m;
+    for (std::size_t t = 0; t < n; ++t) {
+        const glm::dvec3 c(-1.5 + 3.0 * u(rng), -1.0 + 2.0 * u(rng), -2.0 + 8.0 * u(rng));
+        for (int i = 0; i < 3; ++i) {
+            const glm::dvec3 p = c + size * glm::dvec3(u(rng) - 0.5, u(rng) - 0.5, 0.5 * (u(rng) - 0.5));
+            m.positions.push_back(glm::vec3(p));
+            const float a = static_cast<float>(0.2 + 0.8 * u(rng));
+            m.colors.push_back(glm::vec4(a * float(u(rng)), a * float(u(rng)), a * float(u(rng)), a));
+        }
+        add_triangle(m, static_cast<std::uint32_t>(3 * t), static_cast<std::uint32_t>(3 * t + 1),
+                     static_cast<std::uint32_t>(3 * t + 2));
+    }
+    return m;
+}
+
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+}
+
+mr::Camera camera(mr::DepthConvention convention, int W, int H) {
+    const glm::dmat4 view = mr::look_at({0.3, 0.8, 4.0}, {0, 0, 0}, {0, 1, 0});
+    const double far = convention == mr::DepthConvention::opengl ? 20.0 : mr::kInfiniteFar;
+    return mr::Camera::from_matrices(view, mr::perspective(1.0, double(W) / H, 0.05, far, convention), convention);
+}
+
+TEST(BlockSkipping, SameBitsAndCountersAsThePlainPathOnRandomOverlappingScenes) {
+    const int W = 96, H = 80;  // partial tiles at the right and bottom
+    const mr::Mesh a = random_overlap(160, 2.5, 11), b = random_overlap(120, 1.2, 12);
+    glm::dmat4 shifted(1.0);
+    shifted[3] = glm::dvec4(0.2, 0.1, 0.5, 1.0);
+    struct Mode {
+        mr::AntiAliasing aa;
+        int samples;
+    };
+    const Mode modes[] = {{mr::AntiAliasing::ssaa, 1}, {mr::AntiAliasing::ssaa, 4}, {mr::AntiAliasing::msaa, 4},
+                          {mr::AntiAliasing::msaa, 16}};
+    for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
+        const mr::Camera cam = camera(convention, W, H);
+        for (mr::BlendMode blend : {mr::BlendMode::replace, mr::BlendMode::add, mr::BlendMode::over}) {
+            // A depth-tested draw, then one that tests without writing, then one that does not test.
+            mr::DrawState tested;
+            tested.blend = blend;
+            mr::DrawState read_only = tested;
+            read_only.depth_write = false;
+            read_only.interpolation = mr::Interpolation::screen;
+            const std::vector<mr::Draw> draws = {make_draw(a, glm::dmat4(1.0), tested),
+                                                 make_draw(b, glm::dmat4(1.0), read_only, glm::vec4(0.9f, 0.8f, 1.0f, 1.0f)),
+                                                 make_draw(b, shifted,
+                                                           no_depth(blend), glm::vec4(0.3f))};
+            for (const Mode& mode : modes)
+                for (int threads : {1, 2}) {
+                    SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(blend) + ", " +
+                                 mr::to_string(mode.aa) + " " + std::to_string(mode.samples) + ", " +
+                                 std::to_string(threads) + " threads");
+                    auto s = settings(W, H, mode.samples);
+                    s.anti_aliasing = mode.aa;
+                    s.threads = threads;
+                    s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+                    s.block_skipping = false;
+                    const mr::RenderResult plain = mr::render(draws, cam, s);
+                    s.block_skipping = true;
+                    const mr::RenderResult fast = mr::render(draws, cam, s);
+                    EXPECT_EQ(plain.stats.depth_blocks_rejected, 0u);
+                    EXPECT_GT(fast.stats.depth_blocks_rejected, 0u);
+                    EXPECT_TRUE(same_bits(fast.color.pixels, plain.color.pixels)) << "resolved colour differs";
+                    EXPECT_TRUE(same_bits(fast.framebuffer.color, plain.framebuffer.color)) << "samples differ";
+                    EXPECT_TRUE(same_bits(fast.framebuffer.depth, plain.framebuffer.depth)) << "depth differs";
+                    EXPECT_EQ(fast.stats.samples_covered, plain.stats.samples_covered);
+                    EXPECT_EQ(fast.stats.samples_passed, plain.stats.samples_passed);
+                    EXPECT_EQ(fast.stats.shader_invocations, plain.stats.shader_invocations);
+                }
+        }
+    }
+}
+
+TEST(BlockSkipping, TileBuffersAndListedPixelsGiveThePlainImage) {
+    const int W = 70, H = 50;
+    const mr::Mesh a = random_overlap(200, 2.5, 21);
+    const mr::Camera cam = camera(mr::DepthConvention::reverse_z, W, H);
+    const std::vector<mr::Draw> draws = {make_draw(a, glm::dmat4(1.0), mr::DrawState{})};
+    std::vector<std::uint32_t> pixels;
+    for (std::uint32_t i = 0; i < std::uint32_t(W * H); i += 3) pixels.push_back(i);
+    for (int samples : {1, 4})
+        for (bool listed : {false, true}) {
+            SCOPED_TRACE(std::to_string(samples) + " samples" + (listed ? ", listed pixels" : ""));
+            auto s = settings(W, H, samples);
+            s.keep_samples = false;
+            if (listed) s.pixels = pixels;
+            s.block_skipping = false;
+            const mr::RenderResult plain = mr::render(draws, cam, s);
+            s.block_skipping = true;
+            const mr::RenderResult fast = mr::render(draws, cam, s);
+            // Spans of single pixels are too thin for a block test; whole tiles are not.
+            if (!listed) EXPECT_GT(fast.stats.depth_blocks_rejected, 0u);
+            EXPECT_TRUE(same_bits(fast.color.pixels, plain.color.pixels));
+            EXPECT_EQ(fast.stats.samples_covered, plain.stats.samples_covered);
+            EXPECT_EQ(fast.stats.samples_passed, plain.stats.samples_passed);
+        }
+}
+
+TEST(BlockSkipping, AnOccluderDrawnFirstHidesEveryBlockBehindIt) {
+    // A full-screen quad at z = 1, then 50 triangles behind it at z = −1 that cover the screen:
+    // each of them fails everywhere, so every block they fill is skipped and no sample passes.
+    const int W = 64, H = 64;
+    const mr::Camera cam = camera(mr::DepthConvention::reverse_z, W, H);
+    mr::Mesh front, behind;
+    for (glm::vec3 p : {glm::vec3(-9, -9, 1), glm::vec3(9, -9, 1), glm::vec3(9, 9, 1), glm::vec3(-9, 9, 1)}) {
+        front.positions.push_back(p);
+    }
+    add_triangle(front, 0, 1, 2);
+    add_triangle(front, 0, 2, 3);
+    for (std::uint32_t t = 0; t < 50; ++t) {  // each nearer than the one before
+        const float z = -1.5f + 0.01f * float(t);
+        behind.positions.push_back({-20.0f, -20.0f, z});
+        behind.positions.push_back({20.0f, -20.0f, z - 0.5f});
+        behind.positions.push_back({0.0f, 20.0f, z});
+        add_triangle(behind, 3 * t, 3 * t + 1, 3 * t + 2);
+    }
+    auto s = settings(W, H, 4);
+    const mr::RenderResult r = mr::render({make_draw(front, glm::dmat4(1.0), {}), make_draw(behind, glm::dmat4(1.0), {})}, cam, s);
+    const std::uint64_t samples = std::uint64_t(W) * H * 4;
+    EXPECT_EQ(r.stats.samples_covered, 51 * samples);  // counted even where skipped
+    EXPECT_EQ(r.stats.samples_passed, samples);         // the occluder's own
+    EXPECT_EQ(r.stats.depth_blocks_rejected, 50u * (W / 8) * (H / 8));
+    // Drawn the other way round, each nearer surface passes: nothing may be skipped.
+    const mr::RenderResult back_to_front =
+        mr::render({make_draw(behind, glm::dmat4(1.0), {}), make_draw(front, glm::dmat4(1.0), {})}, cam, s);
+    EXPECT_EQ(back_to_front.stats.depth_blocks_rejected, 0u);
+    EXPECT_TRUE(same_bits(back_to_front.color.pixels, r.color.pixels));
+}
+
+}  // namespace
