@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <random>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -144,6 +145,27 @@ inline ::testing::AssertionResult samples_equal(const mr::Framebuffer& fb, const
 /// Triangle count helper for meshes built in tests.
 inline void add_triangle(mr::Mesh& m, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
     m.triangles.push_back(glm::uvec3(a, b, c));
+}
+
+/// `n` random triangles with premultiplied vertex colours: centres uniform in the box lo + [0, extent),
+/// corners within size·[−½, ½]³ of their centre, the z offsets scaled by `z_scale` (< 1: flatter).
+inline mr::Mesh random_triangles(std::size_t n, double size, std::uint64_t seed, const glm::dvec3& lo,
+                                 const glm::dvec3& extent, double z_scale = 1.0) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    mr::Mesh m;
+    for (std::size_t t = 0; t < n; ++t) {
+        const glm::dvec3 c(lo.x + extent.x * u(rng), lo.y + extent.y * u(rng), lo.z + extent.z * u(rng));
+        for (int i = 0; i < 3; ++i) {
+            const glm::dvec3 p = c + size * glm::dvec3(u(rng) - 0.5, u(rng) - 0.5, z_scale * (u(rng) - 0.5));
+            m.positions.push_back(glm::vec3(p));
+            const float a = static_cast<float>(0.2 + 0.8 * u(rng));
+            m.colors.push_back(glm::vec4(a * float(u(rng)), a * float(u(rng)), a * float(u(rng)), a));
+        }
+        add_triangle(m, static_cast<std::uint32_t>(3 * t), static_cast<std::uint32_t>(3 * t + 1),
+                     static_cast<std::uint32_t>(3 * t + 2));
+    }
+    return m;
 }
 
 }  // namespace helpers

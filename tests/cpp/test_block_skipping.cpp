@@ -17,25 +17,11 @@ namespace {
 namespace mr = mipraster;
 using namespace helpers;
 
-/// `n` large random triangles in the box [−2, 2]×[−1.5, 1.5]×[−2, 6] (the cameras below look from
+/// `n` large random triangles in the box [−1.5, 1.5]×[−1, 1]×[−2, 6] (the cameras below look from
 /// z = 4, so some cross the near plane), tilted so their depth varies across them, in random depth
 /// order, with premultiplied vertex colours.
 mr::Mesh random_overlap(std::size_t n, double size, std::uint64_t seed) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    mr::Mesh m;
-    for (std::size_t t = 0; t < n; ++t) {
-        const glm::dvec3 c(-1.5 + 3.0 * u(rng), -1.0 + 2.0 * u(rng), -2.0 + 8.0 * u(rng));
-        for (int i = 0; i < 3; ++i) {
-            const glm::dvec3 p = c + size * glm::dvec3(u(rng) - 0.5, u(rng) - 0.5, 0.5 * (u(rng) - 0.5));
-            m.positions.push_back(glm::vec3(p));
-            const float a = static_cast<float>(0.2 + 0.8 * u(rng));
-            m.colors.push_back(glm::vec4(a * float(u(rng)), a * float(u(rng)), a * float(u(rng)), a));
-        }
-        add_triangle(m, static_cast<std::uint32_t>(3 * t), static_cast<std::uint32_t>(3 * t + 1),
-                     static_cast<std::uint32_t>(3 * t + 2));
-    }
-    return m;
+    return random_triangles(n, size, seed, {-1.5, -1.0, -2.0}, {3.0, 2.0, 8.0}, 0.5);
 }
 
 bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
@@ -116,7 +102,9 @@ TEST(BlockSkipping, TileBuffersAndListedPixelsGiveThePlainImage) {
             s.block_skipping = true;
             const mr::RenderResult fast = mr::render(draws, cam, s);
             // Spans of single pixels are too thin for a block test; whole tiles are not.
-            if (!listed) EXPECT_GT(fast.stats.depth_blocks_rejected, 0u);
+            if (!listed) {
+                EXPECT_GT(fast.stats.depth_blocks_rejected, 0u);
+            }
             EXPECT_TRUE(same_bits(fast.color.pixels, plain.color.pixels));
             EXPECT_EQ(fast.stats.samples_covered, plain.stats.samples_covered);
             EXPECT_EQ(fast.stats.samples_passed, plain.stats.samples_passed);

@@ -28,21 +28,7 @@ using namespace helpers;
 /// `n` random triangles of size about `size` in the box [−2, 2]×[−1.5, 1.5]×[−2, 6] (the camera is
 /// at z = 4, so some cross the near plane or lie behind it), with premultiplied vertex colours.
 mr::Mesh random_triangles(std::size_t n, double size, std::uint64_t seed) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    mr::Mesh m;
-    for (std::size_t t = 0; t < n; ++t) {
-        const glm::dvec3 c(-2.0 + 4.0 * u(rng), -1.5 + 3.0 * u(rng), -2.0 + 8.0 * u(rng));
-        for (int i = 0; i < 3; ++i) {
-            const glm::dvec3 p = c + size * glm::dvec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
-            m.positions.push_back(glm::vec3(p));
-            const float a = static_cast<float>(0.2 + 0.8 * u(rng));
-            m.colors.push_back(glm::vec4(a * float(u(rng)), a * float(u(rng)), a * float(u(rng)), a));
-        }
-        add_triangle(m, static_cast<std::uint32_t>(3 * t), static_cast<std::uint32_t>(3 * t + 1),
-                     static_cast<std::uint32_t>(3 * t + 2));
-    }
-    return m;
+    return helpers::random_triangles(n, size, seed, {-2.0, -1.5, -2.0}, {4.0, 3.0, 8.0});
 }
 
 bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
