@@ -86,6 +86,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             counters.samples_covered += cls.skipped_samples;
             counters.depth_blocks_rejected += static_cast<std::uint64_t>(cls.depth_rejected);
         }
+        // Most small triangles classify no block: they skip the per-pixel block test.
+        const std::uint32_t classified = cls.skipped | cls.hidden;
 
         // The vertex colours of the original triangle, once per triangle and tile.
         VertexValues colors;
@@ -136,7 +138,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 std::uint64_t covered = mask[j];
                 if (!covered) continue;
                 const int px = rx0 + j;
-                if ((cls.skipped | cls.hidden) >> blocks.bit(px, py) & 1) {  // counted, not tested
+                if (classified && (classified >> blocks.bit(px, py) & 1)) {  // counted, not tested
                     if (cls.hidden >> blocks.bit(px, py) & 1)
                         counters.samples_covered += static_cast<std::uint64_t>(__builtin_popcountll(covered));
                     continue;
