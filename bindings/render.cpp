@@ -64,6 +64,7 @@ py::dict stats_dict(const RenderStats& s) {
     d["samples_passed"] = s.samples_passed;
     d["shader_invocations"] = s.shader_invocations;
     d["depth_blocks_rejected"] = s.depth_blocks_rejected;
+    d["tiles_deferred"] = s.tiles_deferred;
     d["threads"] = s.threads;
     d["transform_ms"] = s.transform_ms;
     d["setup_ms"] = s.setup_ms;
@@ -188,6 +189,8 @@ void bind_render(py::module_& m) {
             "resolve_filter", [](const RenderSettings& s) { return to_string(s.resolve_filter); },
             [](RenderSettings& s, const std::string& name) { s.resolve_filter = parse_resolve_filter(name); },
             "reconstruction filter of the resolve: 'box', 'tent', 'mitchell', 'catmull-rom' or 'lanczos3'")
+        .def_readwrite("deferred_shading", &RenderSettings::deferred_shading,
+                       "where triangles overlap deeply and every draw replaces, shade only visible samples")
         .def_readwrite("depth_output", &RenderSettings::depth_output,
                        "return each pixel's view-space depth (nearest sample, +inf where empty)")
         .def_property(

@@ -179,6 +179,7 @@ class RenderSettings:
     threads: int
     keep_samples: bool
     depth_output: bool
+    deferred_shading: bool
     derivatives: str
     debug_view: str
     resolve_filter: str

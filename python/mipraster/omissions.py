@@ -35,6 +35,7 @@ SIZE = (1280, 720)
 QUICK_SIZE = (160, 90)
 GRID_TRIANGLES = 20_000  # about: growth.grid_mesh rounds to whole rows and columns
 OFFSCREEN_TRIANGLES = 200_000
+STACKED_QUADS = 8
 CLOSE_TOLERANCE = 1e-5  # largest |difference| of a linear colour value for 'close'
 
 
@@ -172,6 +173,26 @@ def magnified_quad(width: int, height: int) -> Dict[str, Any]:
     return {"scene": scene, "camera": _ndc_camera(), "texture": texture}
 
 
+def stacked_quads(width: int, height: int) -> Dict[str, Any]:
+    """STACKED_QUADS full-screen textured quads (trilinear, minified checker), depth-tested, drawn
+    in an order where every second one is nearer than all before it: each pixel passes the depth
+    test STACKED_QUADS / 2 + 1 times, and only the nearest quad stays visible."""
+    import mipraster as mr
+
+    half = STACKED_QUADS // 2  # layers far to near: half + 1 … n − 1 interleaved with half − 1 … 0
+    order = [i for pair in zip(range(STACKED_QUADS - 1, half - 1, -1), range(half - 1, -1, -1)) for i in pair]
+    positions, uvs, tris = [], [], []
+    for k, layer in enumerate(order):
+        z = -0.9 + 1.8 * layer / STACKED_QUADS  # OpenGL NDC: smaller z is nearer
+        positions += [[-1, -1, z], [1, -1, z], [1, 1, z], [-1, 1, z]]
+        uvs += [[0, 4], [4, 4], [4, 0], [0, 0]]
+        tris += [[4 * k, 4 * k + 1, 4 * k + 2], [4 * k, 4 * k + 2, 4 * k + 3]]
+    scene = mr.Scene()
+    scene.add(mr.Mesh(np.float32(positions), np.array(tris), uvs=np.float32(uvs)),
+              texture=mr.Texture(_checker(256), srgb=False, name="checker 256"), sampler="trilinear")
+    return {"scene": scene, "camera": _ndc_camera()}
+
+
 def build_all_levels(state: Dict[str, Any]) -> None:
     """Builds every mip level of the state's texture (level k builds the levels above it too)."""
     texture = state["texture"]
@@ -214,6 +235,10 @@ OMISSIONS = [
              Variant("them removed from the input (comparison)", colour_grid()), "exact",
              "no switch turns culling off: the comparison is the same frame without the off-screen triangles, "
              "so the difference is what rejecting them costs, not what culling saves", forced=False),
+    Omission("shading hidden samples (deferred shading)", f"{STACKED_QUADS} stacked full-screen textured quads",
+             Variant("visibility pre-pass, then one shade per visible sample", stacked_quads),
+             Variant("deferred_shading=False: every sample that passes the depth test is shaded",
+                     with_options(stacked_quads, deferred_shading=False)), "exact"),
     Omission("specialization: constant colour", "colour grid with one colour",
              Variant("no vertex colours (constant-colour kernel)", colour_grid(colors="none")),
              Variant("the colour as vertex colours (interpolating kernel)", colour_grid(colors="white-vertex")),

@@ -61,7 +61,8 @@ class RenderResult:
         stats: dict of the renderer's counters (``triangles_in``, ``triangles_clipped``,
             ``triangles_outside``, ``triangles_backface``, ``triangles_degenerate``,
             ``triangles_nonfinite``, ``triangles_rasterized``, ``samples_covered``,
-            ``samples_passed``, ``shader_invocations``, ``depth_blocks_rejected``, ``threads``) and times in milliseconds
+            ``samples_passed``, ``shader_invocations``, ``depth_blocks_rejected``, ``tiles_deferred``: tiles
+            whose visible samples were shaded after a pre-pass, ``threads``) and times in milliseconds
             (``transform_ms``, ``setup_ms``, ``raster_ms``, ``total_ms``).
     """
 
@@ -131,7 +132,8 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
            pattern: str = "auto", seed: int = 0, threads: int = 0, clear_color: Any = None,
            keep_samples: bool = False, depth: bool = True, derivatives: str = "analytic",
            debug_view: str = "none", resolve_filter: str = "box", estimate_error: bool = False,
-           target_error: Optional[float] = None, probe_pixels: Optional[int] = None) -> RenderResult:
+           target_error: Optional[float] = None, probe_pixels: Optional[int] = None,
+           deferred_shading: bool = True) -> RenderResult:
     """Renders ``scene`` through ``camera`` into a ``width`` × ``height`` image.
 
     Args:
@@ -190,6 +192,10 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             None = W·H·spp/(256·K) within [64, 1024] with K reference passes (2, or 4 at 64 spp):
             a quarter of the render's samples; 0 = no probe (the raw halves estimate; needs
             ``spp >= 2``).
+        deferred_shading: where a tile's triangles overlap 2 or more deep and every draw replaces
+            what lies beneath (1 sample or SSAA), find each sample's visible triangle first and
+            shade it once (``stats["tiles_deferred"]`` counts those tiles). The image is the same
+            bit for bit; False shades every sample that passes its depth test, for comparison.
 
     Returns:
         A :class:`RenderResult`.
@@ -214,6 +220,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     pattern_kind = _checks.choice(pattern, "pattern", PATTERNS)
     keep = _checks.flag(keep_samples, "keep_samples")
     depth_output = _checks.flag(depth, "depth")
+    deferred = _checks.flag(deferred_shading, "deferred_shading")
     derivative_mode = _checks.choice(derivatives, "derivatives", DERIVATIVES)
     debug = _checks.choice(debug_view, "debug_view", DEBUG_VIEWS)
     resolve = _checks.choice(resolve_filter, "resolve_filter", {f: f for f in RESAMPLE_FILTERS})
@@ -240,7 +247,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     settings.width, settings.height, settings.samples = w, h, samples
     settings.anti_aliasing, settings.pattern, settings.pattern_seed = anti_aliasing, pattern_kind, pattern_seed
     settings.threads, settings.clear_color, settings.keep_samples = n_threads, clear, keep
-    settings.depth_output = depth_output
+    settings.depth_output, settings.deferred_shading = depth_output, deferred
     settings.derivatives, settings.debug_view = derivative_mode, debug
     settings.resolve_filter = resolve
     settings.estimate_error = (estimate or target_error is not None) and samples >= 2

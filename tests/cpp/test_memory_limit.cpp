@@ -109,8 +109,13 @@ TEST(MemoryLimit, EstimateGrowsWithWhatTheRenderKeeps) {
     // So does a resolve filter wider than a pixel; the error estimate adds its map (4 bytes a pixel).
     EXPECT_EQ(reported_bytes(refusal(draws, wide)) - base, 200u * 100u * 16u * 20u);
     EXPECT_EQ(reported_bytes(refusal(draws, estimated)) - base, 200u * 100u * 4u);
-    // Each further worker adds its tile buffers: 32² pixels × 16 samples × 20 bytes.
-    EXPECT_EQ(reported_bytes(refusal(draws, more_threads)) - base, 3u * 32u * 32u * 16u * 20u);
+    // Each further worker adds its tile buffers: 32² pixels × 16 samples × 24 bytes (colour,
+    // depth and deferred shading's owner), or 20 without deferred shading.
+    EXPECT_EQ(reported_bytes(refusal(draws, more_threads)) - base, 3u * 32u * 32u * 16u * 24u);
+    mr::RenderSettings forward = plain, forward_threads = more_threads;
+    forward.deferred_shading = forward_threads.deferred_shading = false;
+    EXPECT_EQ(reported_bytes(refusal(draws, forward_threads)) - reported_bytes(refusal(draws, forward)),
+              3u * 32u * 32u * 16u * 20u);
 }
 
 TEST(MemoryLimit, RasterizeIsRefusedBeforeAllocating) {

@@ -97,6 +97,14 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         }
         TriangleUvs uvs;
         if constexpr (kTexturing != Texturing::none) uvs = TriangleUvs(t, draw.triangles[t.triangle], draw.uvs, batch.clip_weights);
+        // Deferred shading's pre-pass: the samples this triangle wins name it by this index.
+        std::int32_t owner = -1;
+        if constexpr (kShading == Shading::visibility) {
+            if (target.owners) {
+                owner = static_cast<std::int32_t>(target.owner_refs->size());
+                target.owner_refs->push_back({&t, batch.clip_weights});
+            }
+        }
 
         // Edge offsets of each sample from its pixel's corner: a·ox + b·oy.
         std::int64_t off0[kMaxSamples], off1[kMaxSamples], off2[kMaxSamples];
@@ -204,6 +212,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         }
                         ++counters.samples_passed;
                         if constexpr (kShading == Shading::visibility) {
+                            if (target.owners) {
+                                target.owners[target.owner_index(px, py, s, S)] = owner;
+                                continue;
+                            }
                             const glm::dvec3 w = original_weights(t, perspective_weights(t, l), batch.clip_weights);
                             const std::size_t i = target.barycentrics.index(px, py, s);
                             target.triangle_ids[i] = static_cast<std::int32_t>(t.triangle);
@@ -219,6 +231,58 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
         }
     }
+}
+
+// Deferred shading's second pass (OwnedShadingKernel): each sample owned by a triangle of this
+// draw gets the colour the forward kernel gives it when that triangle draws it (replace blending:
+// the last write is all that remains). The edge values are the forward kernel's, exactly: the
+// same integer sums in another order.
+template <Shading kShading, Texturing kTexturing>
+void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t draw_index, TileCounters& counters) {
+    const SamplePattern& pattern = *target.pattern;
+    const int S = target.color.samples;
+    const std::vector<OwnerRef>& refs = *target.owner_refs;
+    std::int32_t cached = -1;  // the owner whose per-triangle values are below
+    VertexValues colors{};
+    TriangleUvs uvs{};
+    for (int py = target.y0; py < target.y1; ++py)
+        for (int px = target.x0; px < target.x1; ++px) {
+            float* const color_px = target.color.at(px, py, 0);
+            for (int s = 0; s < S; ++s) {
+                const std::int32_t owner = target.owners[target.owner_index(px, py, s, S)];
+                if (owner < 0 || refs[static_cast<std::size_t>(owner)].triangle->draw != draw_index) continue;
+                const SetupTriangle& t = *refs[static_cast<std::size_t>(owner)].triangle;
+                const ClipWeights* const clip_weights = refs[static_cast<std::size_t>(owner)].clip_weights;
+                if (owner != cached) {
+                    cached = owner;
+                    if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective) {
+                        const glm::uvec3 tri = draw.triangles[t.triangle];
+                        colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
+                    }
+                    if constexpr (kTexturing != Texturing::none) uvs = TriangleUvs(t, draw.triangles[t.triangle], draw.uvs, clip_weights);
+                }
+                const std::int64_t X = std::int64_t{px} * kSubpixelOne + pattern.x[s];
+                const std::int64_t Y = std::int64_t{py} * kSubpixelOne + pattern.y[s];
+                const glm::dvec3 l = screen_weights(t, t.edge_a[0] * X + t.edge_b[0] * Y + t.edge_c[0],
+                                                    t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1],
+                                                    t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2]);
+                ++counters.shader_invocations;
+                blend_into<BlendMode::replace>(color_px + 4 * s, shade<kShading, kTexturing>(draw, colors, uvs, t, l, clip_weights, px, py));
+            }
+        }
+}
+
+template <Texturing T>
+OwnedShadingKernel pick_owned_shading(const PipelineKey& k) {
+    if (k.blend != BlendMode::replace || k.samples == SampleMode::msaa) return nullptr;
+    switch (k.shading) {
+        case Shading::constant: return &shade_owned<Shading::constant, T>;
+        case Shading::flat: return &shade_owned<Shading::flat, T>;
+        case Shading::screen: return &shade_owned<Shading::screen, T>;
+        case Shading::perspective: return &shade_owned<Shading::perspective, T>;
+        case Shading::visibility: break;
+    }
+    return nullptr;
 }
 
 // Compile-time table of the instances with one kind of texturing, indexed by the key's enumerators.
@@ -277,6 +341,9 @@ TileKernel pick_visibility(SampleMode m) {
 TileKernel select_untextured(const PipelineKey& key);
 TileKernel select_textured_fixed(const PipelineKey& key);
 TileKernel select_textured_lod(const PipelineKey& key);
+OwnedShadingKernel select_owned_untextured(const PipelineKey& key);
+OwnedShadingKernel select_owned_textured_fixed(const PipelineKey& key);
+OwnedShadingKernel select_owned_textured_lod(const PipelineKey& key);
 
 }  // namespace kernels
 }  // namespace mipraster

@@ -20,4 +20,14 @@ TileKernel select_tile_kernel(const PipelineKey& k) {
     return nullptr;
 }
 
+OwnedShadingKernel select_owned_shading_kernel(const PipelineKey& k) {
+    if (k.shading == Shading::visibility) return nullptr;
+    switch (k.texturing) {
+        case Texturing::none: return kernels::select_owned_untextured(k);
+        case Texturing::fixed: return kernels::select_owned_textured_fixed(k);
+        case Texturing::lod: return kernels::select_owned_textured_lod(k);
+    }
+    return nullptr;
+}
+
 }  // namespace mipraster

@@ -17,6 +17,7 @@
 #include "mipraster/pipeline/rasterize_tile.hpp"
 #include "mipraster/pipeline/triangle_setup.hpp"
 #include "mipraster/pipeline/vertex_transform.hpp"
+#include "tile_blocks.hpp"
 
 namespace mipraster {
 
@@ -223,6 +224,57 @@ void rasterize_tile_chunks(std::size_t tile, const std::vector<BinnedChunk>& chu
     }
 }
 
+// About how many times over the tile's triangles cover the target: 1 for a triangle over all of
+// it, 0 for one that misses it, else its bounding box within the target times the share of its
+// whole bounding box it fills.
+double tile_overdraw(std::size_t tile, const std::vector<BinnedChunk>& chunks, const TileTarget& target) {
+    constexpr double kPixelArea2 = 2.0 * double(kSubpixelOne) * double(kSubpixelOne);  // 2A units per px²
+    const double target_area = double(target.x1 - target.x0) * double(target.y1 - target.y0);
+    const kernels::SampleExtent extent{std::int64_t{target.x0} * kSubpixelOne, std::int64_t{target.y0} * kSubpixelOne,
+                                       std::int64_t{target.x1} * kSubpixelOne - 1, std::int64_t{target.y1} * kSubpixelOne - 1};
+    double area = 0.0;
+    for (const BinnedChunk& chunk : chunks)
+        for (std::uint32_t i = chunk.tile_start[tile]; i < chunk.tile_start[tile + 1]; ++i) {
+            const SetupTriangle& t = chunk.triangles[chunk.tile_triangles[i]];
+            const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
+            const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
+            if (x0 >= x1 || y0 >= y1) continue;
+            const kernels::BlockCoverage coverage = kernels::block_coverage(t, extent);
+            if (coverage == kernels::BlockCoverage::all) {
+                area += target_area;
+            } else if (coverage == kernels::BlockCoverage::some) {
+                const double box = double(t.max_x + 1 - t.min_x) * double(t.max_y + 1 - t.min_y);
+                const double fill = std::min(1.0, 1.0 / (t.inv_area2 * kPixelArea2 * box));
+                area += double(x1 - x0) * double(y1 - y0) * fill;
+            }
+        }
+    return area / target_area;
+}
+
+// Deferred shading of one tile (RenderSettings::deferred_shading): the pre-pass rasterizes and
+// depth-tests every triangle as the forward kernels would, recording for each sample the triangle
+// it ends up with; then each draw shades the samples its triangles own, once each.
+void rasterize_tile_deferred(std::size_t tile, const std::vector<BinnedChunk>& chunks,
+                             const std::vector<TileKernel>& prepass_kernels,
+                             const std::vector<OwnedShadingKernel>& shading_kernels, const std::vector<DrawInputs>& inputs,
+                             const TileTarget& target, TileCounters& counters) {
+    thread_local std::vector<std::int32_t> owners;
+    thread_local std::vector<OwnerRef> refs;
+    owners.assign(std::size_t{kTileSize} * kTileSize * static_cast<std::size_t>(target.color.samples), -1);
+    refs.clear();
+    TileTarget deferred = target;
+    deferred.owners = owners.data();
+    deferred.owner_refs = &refs;
+    rasterize_tile_chunks(tile, chunks, prepass_kernels, inputs, deferred, counters);
+    // refs follow submission order: each draw's triangles come together.
+    for (std::size_t i = 0; i < refs.size();) {
+        const std::uint32_t draw = refs[i].triangle->draw;
+        shading_kernels[draw](deferred, inputs[draw], draw, counters);
+        while (i < refs.size() && refs[i].triangle->draw == draw) ++i;
+    }
+    ++counters.tiles_deferred;
+}
+
 // The pixel rectangle of a tile; its storage windows are the caller's to set.
 TileTarget tile_target(const TileGrid& grid, std::size_t tile, const SamplePattern& pattern) {
     const int tx = static_cast<int>(tile) % grid.tiles_x, ty = static_cast<int>(tile) / grid.tiles_x;
@@ -241,6 +293,7 @@ void add_counters(const std::vector<TileCounters>& tiles, RenderStats& stats) {
         stats.samples_passed += c.samples_passed;
         stats.shader_invocations += c.shader_invocations;
         stats.depth_blocks_rejected += c.depth_blocks_rejected;
+        stats.tiles_deferred += c.tiles_deferred;
     }
 }
 
@@ -254,7 +307,8 @@ std::uint64_t geometry_bytes(std::uint64_t vertices, std::uint64_t triangles) {
 std::uint64_t render_bytes(const std::vector<Draw>& draws, const RenderSettings& settings, int threads,
                            bool needs_depth, bool depth_output) {
     const std::uint64_t pixels = std::uint64_t(settings.width) * std::uint64_t(settings.height);
-    const std::uint64_t sample_bytes = (4 + (needs_depth ? 1 : 0)) * sizeof(float);
+    // Colour, depth, and deferred shading's owner per sample (an int32).
+    const std::uint64_t sample_bytes = (4 + (needs_depth ? 1 : 0) + (settings.deferred_shading ? 1 : 0)) * sizeof(float);
     std::uint64_t bytes = pixels * 4 * sizeof(float);  // the resolved colour
     if (depth_output) bytes += pixels * sizeof(float);
     if (settings.estimate_error) bytes += pixels * sizeof(float);  // the error map
@@ -394,14 +448,22 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     result.color = Image(settings.width, settings.height, 4);
     if (depth_output) result.depth = Image(settings.width, settings.height, 1);
     if (settings.estimate_error) result.error_map = Image(settings.width, settings.height, 1);
-    std::vector<TileKernel> kernels(draws.size());
+    std::vector<TileKernel> kernels(draws.size()), prepass_kernels(draws.size());
+    std::vector<OwnedShadingKernel> shading_kernels(draws.size());
+    bool deferred = settings.deferred_shading;  // every draw has a deferred shading pass
     std::vector<DrawInputs> inputs(draws.size());
     std::vector<std::unique_ptr<TextureView>> textures(draws.size());  // pinned for the render
     for (std::size_t d = 0; d < draws.size(); ++d) {
         const ClipSpaceGeometry& g = geometry[d];
         const Interpolation interpolation =
             effective_interpolation(draws[d].state.interpolation, g.positions.data(), g.positions.size());
-        kernels[d] = select_tile_kernel(pipeline_key(draws[d], interpolation, camera, settings));
+        const PipelineKey key = pipeline_key(draws[d], interpolation, camera, settings);
+        kernels[d] = select_tile_kernel(key);
+        PipelineKey prepass = key;
+        prepass.shading = Shading::visibility;
+        prepass_kernels[d] = select_tile_kernel(prepass);
+        shading_kernels[d] = select_owned_shading_kernel(key);
+        deferred = deferred && shading_kernels[d];
         const Mesh& mesh = *draws[d].mesh;
         inputs[d] = {mesh.triangles.data(), mesh.has_colors() ? mesh.colors.data() : nullptr, draws[d].color,
                      draws[d].state.depth_write};
@@ -470,7 +532,10 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 target.color.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
                 if (needs_depth) target.depth.fill(target.x0, target.y0, target.x1, target.y1, clear_depth4);
             }
-            rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
+            if (deferred && tile_overdraw(tile, chunks, target) >= kDeferredMinOverdraw)
+                rasterize_tile_deferred(tile, chunks, prepass_kernels, shading_kernels, inputs, target, tile_counters[tile]);
+            else
+                rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
         }
         for (const PixelSpan* span = first; span != last; ++span) {
             TileTarget part = target;
@@ -593,6 +658,7 @@ std::string RenderSettings::to_string() const {
            mipraster::to_string(resolve_filter) + ", derivatives=" + mipraster::to_string(derivatives) +
            ", debug_view=" + mipraster::to_string(debug_view) +
            (estimate_error ? ", estimate_error" : "") + (block_skipping ? "" : ", no block skipping") +
+           (deferred_shading ? "" : ", no deferred shading") +
            (tile_mask.empty() ? "" : ", tile_mask=" + std::to_string(tile_mask.size()) + " tiles") +
            (pixels.empty() ? "" : ", pixels=" + std::to_string(pixels.size())) + ")";
 }
@@ -614,7 +680,7 @@ std::string RenderStats::to_json() const {
            field("triangles_degenerate", triangles_degenerate) + field("triangles_nonfinite", triangles_nonfinite) +
            field("triangles_rasterized", triangles_rasterized) + field("samples_covered", samples_covered) +
            field("samples_passed", samples_passed) + field("shader_invocations", shader_invocations) +
-           field("depth_blocks_rejected", depth_blocks_rejected) + field("threads", threads) + field("transform_ms", transform_ms) + field("setup_ms", setup_ms) +
+           field("depth_blocks_rejected", depth_blocks_rejected) + field("tiles_deferred", tiles_deferred) + field("threads", threads) + field("transform_ms", transform_ms) + field("setup_ms", setup_ms) +
            field("raster_ms", raster_ms) + field("total_ms", total_ms, true) + "}";
 }
 
@@ -630,6 +696,7 @@ std::string RenderStats::to_string() const {
            ", rasterized=" + std::to_string(triangles_rasterized) + ", samples_covered=" + std::to_string(samples_covered) +
            ", samples_passed=" + std::to_string(samples_passed) + ", shader_invocations=" +
            std::to_string(shader_invocations) + ", depth_blocks_rejected=" + std::to_string(depth_blocks_rejected) +
+           ", tiles_deferred=" + std::to_string(tiles_deferred) +
            ", threads=" + std::to_string(threads) + ", transform_ms=" +
            ms(transform_ms) + ", setup_ms=" + ms(setup_ms) + ", raster_ms=" + ms(raster_ms) +
            ", total_ms=" + ms(total_ms) + ")";

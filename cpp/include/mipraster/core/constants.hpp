@@ -32,6 +32,12 @@ inline constexpr int kMaxSamples = 64;
 inline constexpr int kTileSize = 32;
 static_assert(kTileSize % 8 == 0 && kTileSize <= 256, "tile size must be a small multiple of 8");
 
+/// Deferred shading (RenderSettings::deferred_shading) takes a tile whose triangles' bounding
+/// boxes cover it this many times over: below, most samples are shaded once anyway and the
+/// pre-pass would only add its owner writes and the second walk over the tile.
+inline constexpr double kDeferredMinOverdraw = 1.25;
+static_assert(kDeferredMinOverdraw >= 1.0, "deferring pays only where triangles overlap");
+
 /// Clipped vertices keep w at least this large so 1/w is finite (the near plane of a sane camera
 /// is far above it; it matters only for degenerate user matrices).
 inline constexpr double kMinClipW = 1e-30;

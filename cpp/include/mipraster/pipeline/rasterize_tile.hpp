@@ -4,10 +4,12 @@
 // draw uses; select_tile_kernel picks the instance.
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
+#include "mipraster/core/constants.hpp"
 #include "mipraster/pipeline/draw.hpp"
 #include "mipraster/pipeline/framebuffer.hpp"
 #include "mipraster/pipeline/sample_pattern.hpp"
@@ -36,6 +38,13 @@ struct PipelineKey {
     Texturing texturing = Texturing::none;
 };
 
+/// A triangle that owns samples in deferred shading's pre-pass: the set-up triangle and the clip
+/// weights of its chunk.
+struct OwnerRef {
+    const SetupTriangle* triangle;
+    const ClipWeights* clip_weights;
+};
+
 /// The pixel rectangle [x0, x1) × [y0, y1) of one tile and the sample storage it writes: RGBA
 /// colour and (when some draw tests depth) depth, each a window that covers the rectangle.
 struct TileTarget {
@@ -49,6 +58,17 @@ struct TileTarget {
     /// Per 8×8-pixel block, skip the samples a triangle cannot cover and the depth tests it would
     /// fail everywhere (the output is the same either way; false runs the plain per-sample path).
     bool block_skipping = true;
+    /// Deferred shading only (heavy overdraw, see renderer.cpp). The pre-pass (Shading::visibility with owners set)
+    /// records per sample the index into owner_refs of the triangle whose colour the sample ends
+    /// up with, or −1; the shading pass then shades each sample once, with that triangle.
+    std::int32_t* owners = nullptr;
+    std::vector<OwnerRef>* owner_refs = nullptr;
+    /// Sample s of pixel (x, y) in `owners`: the tile's pixels row by row from (x0, y0), kTileSize
+    /// per row, S samples each.
+    std::size_t owner_index(int x, int y, int s, int S) const {
+        return (static_cast<std::size_t>(y - y0) * kTileSize + static_cast<std::size_t>(x - x0)) * static_cast<std::size_t>(S) +
+               static_cast<std::size_t>(s);
+    }
 };
 
 /// Per-draw inputs of the kernel.
@@ -83,10 +103,21 @@ struct TileCounters {
     std::uint64_t samples_passed = 0;   ///< of those, passed the depth test
     std::uint64_t shader_invocations = 0;
     std::uint64_t depth_blocks_rejected = 0;  ///< (triangle, 8×8 block) pairs whose depth tests were skipped
+    std::uint64_t tiles_deferred = 0;         ///< tiles shaded after a visibility pre-pass
 };
 
 using TileKernel = void (*)(const TileTarget&, const DrawInputs&, const TriangleBatch&, TileCounters&);
 
 TileKernel select_tile_kernel(const PipelineKey& key);
+
+/// Deferred shading's second pass for one draw: shades every sample of the target whose owner
+/// (recorded by the pre-pass) is a triangle of draw `draw`, exactly as the forward kernel would
+/// have shaded it when that triangle drew it last.
+using OwnedShadingKernel = void (*)(const TileTarget&, const DrawInputs&, std::uint32_t draw, TileCounters&);
+
+/// The shading pass for a draw with this key; null where deferred shading would change the image:
+/// blending other than replace (the result depends on what lies beneath) and MSAA (its one shade
+/// per pixel depends on which samples passed when the triangle was drawn).
+OwnedShadingKernel select_owned_shading_kernel(const PipelineKey& key);
 
 }  // namespace mipraster

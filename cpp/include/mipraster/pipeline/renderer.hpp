@@ -59,6 +59,12 @@ struct RenderSettings {
     /// where it lies behind every depth already stored (they would all fail). The output and the
     /// sample counters are the same either way; false runs the plain per-sample path, for comparison.
     bool block_skipping = true;
+    /// Where a tile's triangles overlap kDeferredMinOverdraw deep or more and every draw blends by
+    /// replacing (at 1 sample or SSAA), shade only the samples that stay visible: a pre-pass
+    /// records which triangle each sample ends up with, then each sample is shaded once. The
+    /// image is the same bit for bit, and so are the counters but shader_invocations; false
+    /// always shades while rasterizing, for comparison.
+    bool deferred_shading = true;
     /// Called as tiles finish with (tiles done, tiles in all); calls are serialized (never
     /// concurrent) but may come from any worker thread. Empty: no progress reports.
     std::function<void(std::size_t, std::size_t)> progress;
@@ -83,6 +89,8 @@ struct RenderStats {
     /// (triangle, 8×8-pixel block) pairs whose depth tests were skipped because the triangle lies
     /// behind every depth stored in the block (RenderSettings::block_skipping).
     std::uint64_t depth_blocks_rejected = 0;
+    /// Tiles shaded after a visibility pre-pass (RenderSettings::deferred_shading).
+    std::uint64_t tiles_deferred = 0;
     int threads = 1;
     double transform_ms = 0, setup_ms = 0;
     double raster_ms = 0;  ///< clear, rasterize, shade, test, blend and resolve, tile by tile

@@ -1,0 +1,186 @@
+// Deferred shading (RenderSettings::deferred_shading): where triangles overlap deeply and every draw
+// replaces, a visibility pre-pass and one shade per visible sample give the image of shading while
+// rasterizing, bit for bit — colour, depth and every counter but shader_invocations — for every
+// shading, texturing, depth setting, sample mode and thread count; the shader then runs exactly once
+// per sample that ends up drawn. Blending and MSAA renders are never deferred.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "helpers.hpp"
+
+namespace {
+
+namespace mr = mipraster;
+using namespace helpers;
+
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+}
+
+mr::Camera camera(mr::DepthConvention convention, int W, int H) {
+    const glm::dmat4 view = mr::look_at({0.3, 0.8, 4.0}, {0, 0, 0}, {0, 1, 0});
+    const double far = convention == mr::DepthConvention::opengl ? 20.0 : mr::kInfiniteFar;
+    return mr::Camera::from_matrices(view, mr::perspective(1.0, double(W) / H, 0.05, far, convention), convention);
+}
+
+/// Large random triangles crossing each other at random depths (some cross the near plane, so
+/// clipped pieces take part), with uvs spanning several texture periods.
+mr::Mesh overlapping(std::size_t n, double size, std::uint64_t seed) {
+    mr::Mesh m = random_triangles(n, size, seed, {-1.5, -1.0, -2.0}, {3.0, 2.0, 8.0}, 0.5);
+    for (std::size_t i = 0; i < m.positions.size(); ++i)
+        m.uvs.push_back(glm::vec2(1.7f * m.positions[i].x + 0.3f * m.positions[i].z, 2.3f * m.positions[i].y));
+    return m;
+}
+
+mr::Texture checker_texture() {
+    const int n = 16;
+    std::vector<float> texels;
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const float v = (x / 2 + y / 2) % 2 ? 0.9f : 0.15f;
+            texels.insert(texels.end(), {v, 0.5f * v + 0.2f * float(x) / n, 1.0f - v, 1.0f});
+        }
+    return mr::Texture::from_float(texels.data(), n, n, 4, true, "deferred checker");
+}
+
+struct Outcome {
+    mr::RenderResult forward, deferred;
+};
+
+Outcome render_both(const std::vector<mr::Draw>& draws, const mr::Camera& cam, mr::RenderSettings s) {
+    s.deferred_shading = false;
+    Outcome o{mr::render(draws, cam, s), {}};
+    s.deferred_shading = true;
+    o.deferred = mr::render(draws, cam, s);
+    return o;
+}
+
+void expect_same_image(const Outcome& o) {
+    EXPECT_EQ(o.forward.stats.tiles_deferred, 0u);
+    EXPECT_TRUE(same_bits(o.deferred.color.pixels, o.forward.color.pixels)) << "resolved colour differs";
+    EXPECT_TRUE(same_bits(o.deferred.framebuffer.color, o.forward.framebuffer.color)) << "samples differ";
+    EXPECT_TRUE(same_bits(o.deferred.framebuffer.depth, o.forward.framebuffer.depth)) << "depth differs";
+    EXPECT_EQ(o.deferred.stats.samples_covered, o.forward.stats.samples_covered);
+    EXPECT_EQ(o.deferred.stats.samples_passed, o.forward.stats.samples_passed);
+    EXPECT_EQ(o.deferred.stats.depth_blocks_rejected, o.forward.stats.depth_blocks_rejected);
+}
+
+TEST(DeferredShading, SameBitsAsShadingWhileRasterizingOnOverlappingScenes) {
+    const int W = 96, H = 80;  // partial tiles at the right and bottom
+    const mr::Mesh a = overlapping(150, 2.5, 31), b = overlapping(100, 1.5, 32);
+    const mr::Texture texture = checker_texture();
+    glm::dmat4 shifted(1.0);
+    shifted[3] = glm::dvec4(0.2, 0.1, 0.5, 1.0);
+    mr::Sampler trilinear, anisotropic, bilinear;
+    anisotropic.footprint = mr::FootprintFilter::anisotropic;
+    bilinear.mip_filter = mr::MipFilter::none;  // no derivatives: the fixed texturing kernel
+    for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
+        const mr::Camera cam = camera(convention, W, H);
+        for (int samples : {1, 4})
+            for (mr::Interpolation interpolation :
+                 {mr::Interpolation::perspective, mr::Interpolation::screen, mr::Interpolation::flat}) {
+                mr::DrawState tested;
+                tested.interpolation = interpolation;
+                mr::DrawState read_only = tested;  // tests depth without writing it
+                read_only.depth_write = false;
+                // Textured with analytic derivatives, untextured, textured without derivatives,
+                // and an untested draw over all of it.
+                std::vector<mr::Draw> draws = {make_draw(a, glm::dmat4(1.0), tested), make_draw(b, glm::dmat4(1.0), read_only),
+                                               make_draw(b, shifted, tested, glm::vec4(0.9f, 0.8f, 1.0f, 1.0f)),
+                                               make_draw(a, shifted, no_depth(), glm::vec4(0.5f))};
+                draws[0].texture = texture;
+                draws[0].sampler = samples == 1 ? anisotropic : trilinear;
+                draws[2].texture = texture;
+                draws[2].sampler = bilinear;
+                draws[3].mesh = &b;
+                for (int threads : {1, 2}) {
+                    SCOPED_TRACE(mr::to_string(convention) + ", " + std::to_string(samples) + " samples, " +
+                                 mr::to_string(interpolation) + ", " + std::to_string(threads) + " threads");
+                    auto s = settings(W, H, samples);
+                    s.threads = threads;
+                    s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+                    const Outcome o = render_both(draws, cam, s);
+                    expect_same_image(o);
+                    EXPECT_GT(o.deferred.stats.tiles_deferred, 0u);
+                    EXPECT_LT(o.deferred.stats.shader_invocations, o.forward.stats.shader_invocations);
+                }
+            }
+    }
+}
+
+TEST(DeferredShading, ShadesEachDrawnSampleExactlyOnce) {
+    // One depth-tested, depth-writing draw: a sample is drawn iff its depth left the clear value
+    // (the test is strict), and deferred shading runs the shader exactly there.
+    const int W = 64, H = 64;
+    const mr::Mesh a = overlapping(200, 2.5, 41);
+    for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl})
+        for (int samples : {1, 4}) {
+            SCOPED_TRACE(mr::to_string(convention) + ", " + std::to_string(samples) + " samples");
+            const mr::Camera cam = camera(convention, W, H);
+            const float clear_depth = convention == mr::DepthConvention::opengl ? 1.0f : 0.0f;
+            const mr::RenderResult r = mr::render({make_draw(a, glm::dmat4(1.0), mr::DrawState{})}, cam, settings(W, H, samples));
+            ASSERT_EQ(r.stats.tiles_deferred, std::uint64_t((W / 32) * (H / 32)));  // every tile is deep here
+            std::uint64_t drawn = 0;
+            for (float z : r.framebuffer.depth) drawn += z != clear_depth;
+            EXPECT_EQ(r.stats.shader_invocations, drawn);
+            EXPECT_LT(r.stats.shader_invocations, r.stats.samples_passed);  // overdraw was left out
+        }
+}
+
+TEST(DeferredShading, TileBuffersAndListedPixelsGiveTheForwardImage) {
+    const int W = 70, H = 50;
+    const mr::Mesh a = overlapping(200, 2.5, 51);
+    const mr::Camera cam = camera(mr::DepthConvention::reverse_z, W, H);
+    std::vector<mr::Draw> draws = {make_draw(a, glm::dmat4(1.0), mr::DrawState{})};
+    draws[0].texture = checker_texture();
+    std::vector<std::uint32_t> pixels;
+    for (std::uint32_t i = 0; i < std::uint32_t(W * H); ++i)
+        if (i % 5) pixels.push_back(i);  // most of each tile: rasterized whole, resolved where listed
+    for (int samples : {1, 4})
+        for (bool listed : {false, true}) {
+            SCOPED_TRACE(std::to_string(samples) + " samples" + (listed ? ", listed pixels" : ""));
+            auto s = settings(W, H, samples);
+            s.keep_samples = false;
+            if (listed) s.pixels = pixels;
+            const Outcome o = render_both(draws, cam, s);
+            expect_same_image(o);
+            if (!listed || samples > 1) {
+                EXPECT_GT(o.deferred.stats.tiles_deferred, 0u);
+            }
+        }
+}
+
+TEST(DeferredShading, BlendingMsaaAndShallowScenesShadeWhileRasterizing) {
+    const int W = 64, H = 64;
+    const mr::Mesh deep = overlapping(200, 2.5, 61), shallow = overlapping(3, 0.3, 62);
+    const mr::Camera cam = camera(mr::DepthConvention::reverse_z, W, H);
+    mr::DrawState over;
+    over.blend = mr::BlendMode::over;
+    struct Case {
+        std::string name;
+        std::vector<mr::Draw> draws;
+        mr::AntiAliasing aa;
+        int samples;
+    };
+    const Case cases[] = {
+        {"one blended draw among opaque ones", {make_draw(deep, glm::dmat4(1.0), {}), make_draw(deep, glm::dmat4(1.0), over)},
+         mr::AntiAliasing::ssaa, 4},
+        {"msaa", {make_draw(deep, glm::dmat4(1.0), {})}, mr::AntiAliasing::msaa, 4},
+        {"few small triangles", {make_draw(shallow, glm::dmat4(1.0), {})}, mr::AntiAliasing::ssaa, 4},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        auto s = settings(W, H, c.samples);
+        s.anti_aliasing = c.aa;
+        const Outcome o = render_both(c.draws, cam, s);
+        expect_same_image(o);
+        EXPECT_EQ(o.deferred.stats.tiles_deferred, 0u);
+        EXPECT_EQ(o.deferred.stats.shader_invocations, o.forward.stats.shader_invocations);
+    }
+}
+
+}  // namespace
