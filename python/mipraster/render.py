@@ -187,7 +187,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             ``stats['total_ms']`` is the time of all passes and probes; ``pixel_spp`` shows where
             samples went, ``adaptive`` which plan each pass took. Needs the box resolve.
         probe_pixels: pixels the probe renders again (``estimate_error`` / ``target_error``):
-            None = W·H·spp/(256·K) within [64, 1024] with K reference passes (2, or 4 at 64 spp):
+            None = W·H·spp/(256·K) within [512, 4096] with K reference passes (2, or 4 at 64 spp):
             a quarter of the render's samples; 0 = no probe (the raw halves estimate; needs
             ``spp >= 2``).
 
