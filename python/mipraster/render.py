@@ -180,7 +180,8 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             extra pass of just those pixels: the fewest samples that bring the image's estimated
             RMSE to ``target_error`` (an RMSE in linear colour) with error ∝ 1/√spp; repeated
             (at most 4 passes) while the estimate misses the target and some pixel with error
-            has fewer than 64; each round's error is a new probe of the image. While every pixel
+            has fewer than 64; each round's error is a probe of the new image with the first
+            probe's draws and reference passes (no reference pixel rendered again). While every pixel
             has the same count, a cost model from measured per-sample times weighs that pass
             against a uniform render of every pixel at the samples predicted to meet the target,
             and the cheaper one is rendered (see :mod:`mipraster.adaptive`).
