@@ -108,7 +108,7 @@ constexpr const char* kUsage =
     "                        interleaved halves of the samples, scaled to the probe's RMSE\n"
     "                        (.exr linear, .png sRGB grey); spp >= 2\n"
     "  --probe-pixels N      pixels the probe renders again; 0 = no probe (the raw halves\n"
-    "                        estimate, spp >= 2)   [W*H*spp/(256*K) within 64..1024, K passes]\n"
+    "                        estimate, spp >= 2)   [W*H*spp/(256*K) within 512..4096, K passes]\n"
     "  --quiet               print nothing but errors (no summary, no progress bar)\n"
     "\n"
     "compare A B [options]: values are compared as read (linear float; 8-bit files are decoded\n"

@@ -10,7 +10,12 @@ each candidate count S (S₀·2^k, up to 64) the pixels with the largest gains a
 image's predicted mean squared error meets the target T²; the candidate with the fewest new samples
 (pixels × S) wins, and only those pixels are rendered again, in one pass of the C++ renderer
 (``RenderSettings.pixels``: one transform and setup, each row of chosen pixels in a tile one span).
-Their colour and halves replace the first pass's, and the probe measures the new image.
+Their colour and halves replace the first pass's, and the probe measures the new image: with the
+first probe's draws and reference passes (a :class:`mipraster.error_probe.ProbeReference`), so a
+later probe renders no reference pixel again and costs only its arithmetic (and any passes it
+adds). Each probe is still unbiased for the image it measures given that image; what links them
+is that the image after a pass depends on the first probe's draws through one number, the
+measured RMSE that scales the plan.
 
 Each round also prices the plain alternative while every pixel still has the same count s: a
 uniform render of the whole image at the fewest samples S_u (s·2^k, up to 64) whose predicted error
@@ -130,7 +135,7 @@ def render_adaptive_settings(draws: List[Any], camera: Any, settings: Any, targe
     Raises ValueError for a target that is not a finite number > 0, with ``keep_samples`` or with
     a resolve filter other than box.
     """
-    from .error_probe import guide, measure_error, rms
+    from .error_probe import ProbeReference, guide, measure_error, rms
     from .render import RenderResult
 
     target = _checks.real(target_error, "target_error")
@@ -157,14 +162,15 @@ def render_adaptive_settings(draws: List[Any], camera: Any, settings: Any, targe
     passes_done: List[AdaptivePass] = []
     probe = None
     likely = None
+    reference = ProbeReference()  # the first probe's draws and passes, measured against by every probe
     for passes in range(MAX_PASSES + 1):
-        # The probe may choose its pixels by any guide that is not the reference's: the latest
-        # guide, but only computed again when a pass is to be planned on it.
+        # The first probe draws its pixels by the first pass's guide; later probes measure the same
+        # draws (``reference``). The guide is computed again only when a pass is to be planned on it.
         if likely is None:
             likely = guide(color, halves)
         if probe_pixels > 0:
             probe = measure_error(draws, camera, settings, color, halves, probe_pixels, seed=settings.pattern_seed,
-                                  guide_map=likely)
+                                  guide_map=likely, reuse=reference)
             measured = probe.rmse
         else:
             measured = rms(halves)

@@ -182,14 +182,15 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             extra pass of just those pixels: the fewest samples that bring the image's estimated
             RMSE to ``target_error`` (an RMSE in linear colour) with error ∝ 1/√spp; repeated
             (at most 4 passes) while the estimate misses the target and some pixel with error
-            has fewer than 64; each round's error is a new probe of the image. While every pixel
+            has fewer than 64; each round's error is a probe of the new image with the first
+            probe's draws and reference passes (no reference pixel rendered again). While every pixel
             has the same count, a cost model from measured per-sample times weighs that pass
             against a uniform render of every pixel at the samples predicted to meet the target,
             and the cheaper one is rendered (see :mod:`mipraster.adaptive`).
             ``stats['total_ms']`` is the time of all passes and probes; ``pixel_spp`` shows where
             samples went, ``adaptive`` which plan each pass took. Needs the box resolve.
         probe_pixels: pixels the probe renders again (``estimate_error`` / ``target_error``):
-            None = W·H·spp/(256·K) within [64, 1024] with K reference passes (2, or 4 at 64 spp):
+            None = W·H·spp/(256·K) within [512, 4096] with K reference passes (2, or 4 at 64 spp):
             a quarter of the render's samples; 0 = no probe (the raw halves estimate; needs
             ``spp >= 2``).
         deferred_shading: where a tile's triangles overlap 2 or more deep and every draw replaces

@@ -1,7 +1,9 @@
 // The error probe (error_probe.hpp): its guide against hand-computed values; its estimate against
 // the hand-computed error of a render whose only error is one half-covered column; a flat image
 // gives zero without extra passes; an exact image whose error is below the
-// reference's own makes the passes double and ends in an upper bound; bad input names itself.
+// reference's own makes the passes double and ends in an upper bound; a kept ProbeReference gives
+// a later probe exactly a fresh probe's estimate of the same draws without rendering a reference
+// pixel again; bad input names itself.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -109,6 +111,50 @@ TEST(ErrorProbe, ErrorBelowTheReferencesOwnDoublesThePassesThenIsABound) {
     EXPECT_TRUE(p.upper_bound) << p.to_string();
     EXPECT_GT(p.reference_rmse, 0.0);
     EXPECT_LT(p.rmse, 0.01) << p.to_string();  // the bound is tight
+}
+
+TEST(ErrorProbe, ReusedReferenceIsAFreshProbeOfTheSameDraws) {
+    // The half-covered column of MeasuresAHalfCoveredColumn: image a is its 1-spp render (RMSE
+    // 1/8), image b the same with column 8 at ¼ instead of 0 (RMSE 1/16: a better image of the
+    // same scene, as after an adaptive pass).
+    const int w = 16, h = 8;
+    const mr::Mesh m = pixel_mesh({{-1, -1}, {8.5f, -1}, {8.5f, 9}, {-1, -1}, {8.5f, 9}, {-1, 9}});
+    const mr::Draw d = make_draw(m, fixed_to_ndc(w, h), no_depth());
+    const mr::RenderSettings s = settings(w, h, 1);
+    const mr::Image a = mr::render({d}, identity_camera(), s).color;
+    mr::Image b = a;
+    for (int y = 0; y < h; ++y)
+        for (int c = 0; c < 3; ++c) b.at(8, y, c) = 0.25f;
+    mr::ProbeReference kept;
+    EXPECT_TRUE(kept.empty());
+    const mr::ErrorProbe pa = mr::measure_error({d}, identity_camera(), s, a, nullptr, 96, 5, nullptr, &kept);
+    ASSERT_FALSE(kept.empty());
+    EXPECT_EQ(kept.chosen.size(), 96u);
+    EXPECT_EQ(kept.passes, mr::kProbeMinPasses);
+    EXPECT_EQ(pa.rendered_passes, mr::kProbeMinPasses);
+    EXPECT_EQ(pa.rmse, mr::measure_error({d}, identity_camera(), s, a, nullptr, 96, 5).rmse);  // filling changes nothing
+    // A fresh probe of b with the same seed and a's guide draws the same pixels and renders the same passes.
+    const mr::Image guide_a = mr::error_guide(a, nullptr);
+    const mr::ErrorProbe fresh = mr::measure_error({d}, identity_camera(), s, b, nullptr, 96, 5, &guide_a);
+    const std::vector<std::uint32_t> drawn = kept.chosen;
+    // The reused probe is given other draws of the scene (an empty scene, whose reference would
+    // be black), another seed and pixel count: it must use neither, so it rendered no pass.
+    const mr::ErrorProbe reused = mr::measure_error({}, identity_camera(), s, b, nullptr, 7, 99, nullptr, &kept);
+    EXPECT_EQ(reused.rmse, fresh.rmse) << reused.to_string() << " against " << fresh.to_string();
+    EXPECT_EQ(reused.standard_error, fresh.standard_error);
+    EXPECT_EQ(reused.reference_rmse, fresh.reference_rmse);
+    EXPECT_EQ(reused.pixels, 96);
+    EXPECT_EQ(reused.rendered_passes, 0);
+    EXPECT_EQ(fresh.rendered_passes, mr::kProbeMinPasses);
+    EXPECT_EQ(reused.distinct_pixels, fresh.distinct_pixels);
+    EXPECT_EQ(kept.chosen, drawn);
+    EXPECT_EQ(kept.passes, mr::kProbeMinPasses);
+    EXPECT_GT(reused.rmse, 0.0);
+    EXPECT_LT(reused.rmse, 0.75 * pa.rmse);  // b is the better image (1/16 against 1/8), and the probe says so
+    // Draws made for a 16×8 image do not fit another size.
+    const mr::Image other(8, 8, 4);
+    EXPECT_THROW(mr::measure_error({d}, identity_camera(), settings(8, 8, 1), other, nullptr, 96, 5, nullptr, &kept),
+                 std::invalid_argument);
 }
 
 TEST(ErrorProbe, BadInputNamesItself) {

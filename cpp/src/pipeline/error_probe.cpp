@@ -35,13 +35,21 @@ struct Estimate {
 
 }  // namespace
 
+std::string ProbeReference::to_string() const {
+    char out[160];
+    std::snprintf(out, sizeof out, "ProbeReference(%zu draws, %zu pixels, %d passes of %d samples, %dx%d)", chosen.size(),
+                  distinct.size(), passes, kProbeReferenceSpp, width, height);
+    return out;
+}
+
 std::string ErrorProbe::to_string() const {
     char head[160], halves[48] = "";
     std::snprintf(head, sizeof head, "ErrorProbe(rmse%s%.4g \u00b1 %.2g, pixels=%d (%d distinct) at %d spp",
                   upper_bound ? "<=" : "=", rmse, standard_error, pixels, distinct_pixels, reference_spp);
     if (halves_rmse >= 0.0) std::snprintf(halves, sizeof halves, ", halves_rmse=%.4g", halves_rmse);
-    char tail[96];
-    std::snprintf(tail, sizeof tail, ", reference_rmse=%.3g, ms=%.2f)", reference_rmse, ms);
+    char tail[128];
+    std::snprintf(tail, sizeof tail, ", reference_rmse=%.3g, rendered_passes=%d, ms=%.2f)", reference_rmse,
+                  rendered_passes, ms);
     return std::string(head) + halves + tail;
 }
 
@@ -103,7 +111,7 @@ std::vector<Draw> reference_draws(const std::vector<Draw>& draws) {
 
 ErrorProbe measure_error(const std::vector<Draw>& draws, const Camera& camera, const RenderSettings& settings,
                          const Image& color, const Image* halves_map, int pixels, std::uint64_t seed,
-                         const Image* guide) {
+                         const Image* guide, ProbeReference* reuse) {
     const auto start = std::chrono::steady_clock::now();
     if (pixels < 1) throw std::invalid_argument("probe_pixels: expected a number of pixels >= 1, got " + std::to_string(pixels));
     if (color.channels < 3) throw std::invalid_argument("color: expected 3 or 4 channels, got " + color.to_string());
@@ -122,36 +130,58 @@ ErrorProbe measure_error(const std::vector<Draw>& draws, const Camera& camera, c
         probe.halves_rmse = std::sqrt(sum / double(n_all));
     }
 
-    // Step 1: the draws, i.i.d. from p_i = ½/N + ½·g_i/Σg.
-    const Image g = guide ? *guide : error_guide(color, halves_map);
-    double total = 0.0;
-    for (const float v : g.pixels) total += v;
-    std::vector<double> cdf(n_all);
-    double running = 0.0;
-    for (std::size_t i = 0; i < n_all; ++i) {
-        running += total > 0.0 ? 0.5 / double(n_all) + 0.5 * g.pixels[i] / total : 1.0 / double(n_all);
-        cdf[i] = running;
+    if (reuse && !reuse->empty() && (reuse->width != w || reuse->height != color.height))
+        throw std::invalid_argument("reuse: the probe's draws were made for a " + std::to_string(reuse->width) + "x" +
+                                    std::to_string(reuse->height) + " image, got " + color.to_string());
+    ProbeReference fresh;
+    ProbeReference& r = reuse ? *reuse : fresh;
+    if (r.empty()) {
+        r = ProbeReference{};
+        r.width = w;
+        r.height = color.height;
+        r.seed = seed;
+        // Step 1: the draws, i.i.d. from p_i = ½/N + ½·g_i/Σg.
+        const Image g = guide ? *guide : error_guide(color, halves_map);
+        double total = 0.0;
+        for (const float v : g.pixels) total += v;
+        std::vector<double> cdf(n_all);
+        double running = 0.0;
+        for (std::size_t i = 0; i < n_all; ++i) {
+            running += total > 0.0 ? 0.5 / double(n_all) + 0.5 * g.pixels[i] / total : 1.0 / double(n_all);
+            cdf[i] = running;
+        }
+        std::uint64_t state = seed;
+        state = splitmix64(state) ^ ((std::uint64_t(std::uint32_t(w)) << 32) | std::uint32_t(color.height));
+        state = splitmix64(state) ^ std::uint64_t(std::uint32_t(pixels));
+        r.chosen.resize(static_cast<std::size_t>(pixels));
+        for (std::uint32_t& c : r.chosen) {
+            const std::size_t i = static_cast<std::size_t>(
+                std::upper_bound(cdf.begin(), cdf.end(), uniform01(state) * running) - cdf.begin());
+            c = static_cast<std::uint32_t>(std::min(i, n_all - 1));
+        }
+        r.distinct = r.chosen;
+        std::sort(r.distinct.begin(), r.distinct.end());
+        r.distinct.erase(std::unique(r.distinct.begin(), r.distinct.end()), r.distinct.end());
+        // The probability of each draw, and where its pixel's reference is kept.
+        r.probability.resize(r.chosen.size());
+        r.slot.resize(r.chosen.size());
+        for (std::size_t k = 0; k < r.chosen.size(); ++k) {
+            const std::size_t i = r.chosen[k];
+            r.probability[k] = (cdf[i] - (i ? cdf[i - 1] : 0.0)) / running;
+            r.slot[k] = static_cast<std::size_t>(std::lower_bound(r.distinct.begin(), r.distinct.end(), r.chosen[k]) -
+                                                 r.distinct.begin());
+        }
+        r.mean.assign(r.distinct.size() * 3, 0.0);
+        r.m2.assign(r.distinct.size() * 3, 0.0);
     }
-    std::uint64_t state = seed;
-    state = splitmix64(state) ^ ((std::uint64_t(std::uint32_t(w)) << 32) | std::uint32_t(color.height));
-    state = splitmix64(state) ^ std::uint64_t(std::uint32_t(pixels));
-    std::vector<std::uint32_t> chosen(static_cast<std::size_t>(pixels));
-    for (std::uint32_t& c : chosen) {
-        const std::size_t i = static_cast<std::size_t>(
-            std::upper_bound(cdf.begin(), cdf.end(), uniform01(state) * running) - cdf.begin());
-        c = static_cast<std::uint32_t>(std::min(i, n_all - 1));
-    }
-    std::vector<std::uint32_t> distinct = chosen;
-    std::sort(distinct.begin(), distinct.end());
-    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
-    // The probability of each draw, and where its pixel's reference is kept.
-    std::vector<double> p(chosen.size());
-    std::vector<std::size_t> slot(chosen.size());
-    for (std::size_t k = 0; k < chosen.size(); ++k) {
-        const std::size_t i = chosen[k];
-        p[k] = (cdf[i] - (i ? cdf[i - 1] : 0.0)) / running;
-        slot[k] = static_cast<std::size_t>(std::lower_bound(distinct.begin(), distinct.end(), chosen[k]) - distinct.begin());
-    }
+    const std::vector<std::uint32_t>& chosen = r.chosen;
+    const std::vector<std::uint32_t>& distinct = r.distinct;
+    const std::vector<double>& p = r.probability;
+    const std::vector<std::size_t>& slot = r.slot;
+    std::vector<double>& mean = r.mean;
+    std::vector<double>& m2 = r.m2;
+    int& done = r.passes;
+    const int reused_passes = done;
 
     // Step 2: reference passes of the listed pixels, folded into per-pixel running means and
     // sums of squared deviations (Welford) per channel.
@@ -166,12 +196,11 @@ ErrorProbe measure_error(const std::vector<Draw>& draws, const Camera& camera, c
     ref.derivatives = settings.derivatives;
     ref.debug_view = settings.debug_view;
     ref.pixels = distinct;
-    const std::vector<Draw> ref_draws = reference_draws(draws);
-    std::vector<double> mean(distinct.size() * 3, 0.0), m2(distinct.size() * 3, 0.0);
-    int done = 0;
+    std::vector<Draw> ref_draws;  // made only when a pass is to be rendered
     auto add_passes = [&](int passes) {
+        if (done < passes && ref_draws.empty()) ref_draws = reference_draws(draws);
         for (; done < passes; ++done) {
-            ref.pattern_seed = (kReferenceSeed + std::uint64_t(done)) ^ seed;
+            ref.pattern_seed = (kReferenceSeed + std::uint64_t(done)) ^ r.seed;
             const Image pass = render(ref_draws, camera, ref).color;
             for (std::size_t j = 0; j < distinct.size(); ++j)
                 for (int c = 0; c < 3; ++c) {
@@ -212,8 +241,9 @@ ErrorProbe measure_error(const std::vector<Draw>& draws, const Camera& camera, c
     };
 
     // Step 4: more passes while the error is unresolved and the reference's own error is what
-    // hides it (not the few pixels drawn: more passes would not help that).
-    int passes = probe_reference_passes(settings.samples);
+    // hides it (not the few pixels drawn: more passes would not help that). A reused reference
+    // starts with the passes it has.
+    int passes = std::max(done, probe_reference_passes(settings.samples));
     add_passes(passes);
     Estimate e = estimate();
     auto hidden = [](const Estimate& x) {
@@ -225,9 +255,10 @@ ErrorProbe measure_error(const std::vector<Draw>& draws, const Camera& camera, c
         e = estimate();
     }
 
-    probe.pixels = pixels;
+    probe.pixels = static_cast<int>(chosen.size());
     probe.distinct_pixels = static_cast<int>(distinct.size());
     probe.reference_spp = kProbeReferenceSpp * passes;
+    probe.rendered_passes = passes - reused_passes;
     probe.reference_rmse = std::sqrt(std::max(0.0, e.reference_mse));
     if (hidden(e)) {
         probe.upper_bound = true;

@@ -23,6 +23,10 @@
 //    If the reference still hides it, the probe reports an upper bound: rmse = √(max(MSE, 0) +
 //    2·SE), upper_bound = true ("rmse <= x"). An MSE that is noisy only because few pixels were
 //    drawn stays a point estimate with its standard error (more passes would not help).
+// 5. Reuse. The reference of a drawn pixel depends on the seed, the pass and the pixel only, not
+//    on the image measured: a ProbeReference keeps the draws and their passes, so that a later
+//    probe of another image of the same scene (adaptive quality, after a refinement pass) renders
+//    no reference pixel again and gives exactly what a fresh probe of the same draws would.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -42,10 +46,27 @@ struct ErrorProbe {
     int pixels = 0;             ///< draws n (a pixel drawn twice counts twice)
     int distinct_pixels = 0;    ///< pixels rendered again
     int reference_spp = 0;      ///< samples per pixel of the reference (all passes)
+    int rendered_passes = 0;    ///< reference passes this probe rendered (0: all reused from a ProbeReference)
     double reference_rmse = 0;  ///< the reference's own estimated RMSE over the image
     double halves_rmse = -1;    ///< RMS of the halves map; −1 without one
     double ms = 0;              ///< wall time of the probe (choice, reference passes, arithmetic)
 
+    std::string to_string() const;
+};
+
+/// The draws of a probe and their reference passes (step 5): filled by the first measure_error
+/// given it, reused by later ones.
+struct ProbeReference {
+    int width = 0, height = 0;              ///< of the image the draws were made for
+    std::uint64_t seed = 0;                 ///< the probe's seed (the passes' pattern seeds derive from it)
+    std::vector<std::uint32_t> chosen;      ///< the draws, pixel indices y·W + x
+    std::vector<double> probability;        ///< p of each draw
+    std::vector<std::uint32_t> distinct;    ///< the pixels drawn, sorted
+    std::vector<std::size_t> slot;          ///< each draw's index in distinct
+    int passes = 0;                         ///< reference passes rendered so far
+    std::vector<double> mean, m2;           ///< per distinct pixel and R, G, B: the passes' mean, Σ squared deviations
+
+    bool empty() const { return passes == 0; }
     std::string to_string() const;
 };
 
@@ -71,11 +92,14 @@ std::vector<Draw> reference_draws(const std::vector<Draw>& draws);
 /// `settings` (its size, threads, clear colour, derivatives, debug view and samples per pixel are
 /// used), from `pixels` pixels rendered again at reference quality. `halves_map` (H, W, 1) is the
 /// render's halves map or null; `guide` is error_guide(color, halves_map) when the caller has it,
-/// else null; `seed` makes another choice. Throws std::invalid_argument naming a bad input
-/// (probe_pixels < 1, a map of the wrong size, colour with fewer than 3 channels).
+/// else null; `seed` makes another choice. `reuse`, when given and filled, supplies the draws and
+/// the reference passes instead (`pixels`, `seed` and the guide are then not used; passes are added
+/// to it when needed); when given empty, it is filled. Throws std::invalid_argument naming a bad
+/// input (probe_pixels < 1, a map of the wrong size, colour with fewer than 3 channels, a `reuse`
+/// made for another image size).
 ErrorProbe measure_error(const std::vector<Draw>& draws, const Camera& camera, const RenderSettings& settings,
                          const Image& color, const Image* halves_map, int pixels, std::uint64_t seed,
-                         const Image* guide = nullptr);
+                         const Image* guide = nullptr, ProbeReference* reuse = nullptr);
 
 /// Scales `error_map` (the halves map the probe was given) so that its RMS is the probe's RMSE;
 /// leaves a map that is zero everywhere as it is.
