@@ -3,6 +3,7 @@
 // render wrappers and framebuffer accessors. Expected values come from oracle.hpp, never from here.
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <cstddef>
 #include <cstdint>
 #include <random>
@@ -166,6 +167,20 @@ inline mr::Mesh random_triangles(std::size_t n, double size, std::uint64_t seed,
                      static_cast<std::uint32_t>(3 * t + 2));
     }
     return m;
+}
+
+/// Whether two float buffers hold the same bits (bit-identical renders).
+inline bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+}
+
+/// A perspective camera at (0.3, 0.8, 4) looking at the origin, for scenes of random_triangles in
+/// [−1.5, 1.5]×[−1, 1]×[−2, 6] (some cross its near plane).
+inline mr::Camera overlap_camera(mr::DepthConvention convention, int width, int height) {
+    const glm::dmat4 view = mr::look_at({0.3, 0.8, 4.0}, {0, 0, 0}, {0, 1, 0});
+    const double far = convention == mr::DepthConvention::opengl ? 20.0 : mr::kInfiniteFar;
+    return mr::Camera::from_matrices(view, mr::perspective(1.0, double(width) / height, 0.05, far, convention),
+                                     convention);
 }
 
 }  // namespace helpers

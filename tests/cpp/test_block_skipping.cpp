@@ -24,16 +24,6 @@ mr::Mesh random_overlap(std::size_t n, double size, std::uint64_t seed) {
     return random_triangles(n, size, seed, {-1.5, -1.0, -2.0}, {3.0, 2.0, 8.0}, 0.5);
 }
 
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
-}
-
-mr::Camera camera(mr::DepthConvention convention, int W, int H) {
-    const glm::dmat4 view = mr::look_at({0.3, 0.8, 4.0}, {0, 0, 0}, {0, 1, 0});
-    const double far = convention == mr::DepthConvention::opengl ? 20.0 : mr::kInfiniteFar;
-    return mr::Camera::from_matrices(view, mr::perspective(1.0, double(W) / H, 0.05, far, convention), convention);
-}
-
 TEST(BlockSkipping, SameBitsAndCountersAsThePlainPathOnRandomOverlappingScenes) {
     const int W = 96, H = 80;  // partial tiles at the right and bottom
     const mr::Mesh a = random_overlap(160, 2.5, 11), b = random_overlap(120, 1.2, 12);
@@ -46,7 +36,7 @@ TEST(BlockSkipping, SameBitsAndCountersAsThePlainPathOnRandomOverlappingScenes) 
     const Mode modes[] = {{mr::AntiAliasing::ssaa, 1}, {mr::AntiAliasing::ssaa, 4}, {mr::AntiAliasing::msaa, 4},
                           {mr::AntiAliasing::msaa, 16}};
     for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
-        const mr::Camera cam = camera(convention, W, H);
+        const mr::Camera cam = overlap_camera(convention, W, H);
         for (mr::BlendMode blend : {mr::BlendMode::replace, mr::BlendMode::add, mr::BlendMode::over}) {
             // A depth-tested draw, then one that tests without writing, then one that does not test.
             mr::DrawState tested;
@@ -87,7 +77,7 @@ TEST(BlockSkipping, SameBitsAndCountersAsThePlainPathOnRandomOverlappingScenes) 
 TEST(BlockSkipping, TileBuffersAndListedPixelsGiveThePlainImage) {
     const int W = 70, H = 50;
     const mr::Mesh a = random_overlap(200, 2.5, 21);
-    const mr::Camera cam = camera(mr::DepthConvention::reverse_z, W, H);
+    const mr::Camera cam = overlap_camera(mr::DepthConvention::reverse_z, W, H);
     const std::vector<mr::Draw> draws = {make_draw(a, glm::dmat4(1.0), mr::DrawState{})};
     std::vector<std::uint32_t> pixels;
     for (std::uint32_t i = 0; i < std::uint32_t(W * H); i += 3) pixels.push_back(i);
@@ -115,7 +105,7 @@ TEST(BlockSkipping, AnOccluderDrawnFirstHidesEveryBlockBehindIt) {
     // A full-screen quad at z = 1, then 50 triangles behind it at z = −1 that cover the screen:
     // each of them fails everywhere, so every block they fill is skipped and no sample passes.
     const int W = 64, H = 64;
-    const mr::Camera cam = camera(mr::DepthConvention::reverse_z, W, H);
+    const mr::Camera cam = overlap_camera(mr::DepthConvention::reverse_z, W, H);
     mr::Mesh front, behind;
     for (glm::vec3 p : {glm::vec3(-9, -9, 1), glm::vec3(9, -9, 1), glm::vec3(9, 9, 1), glm::vec3(-9, 9, 1)}) {
         front.positions.push_back(p);

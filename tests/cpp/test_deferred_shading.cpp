@@ -17,16 +17,6 @@ namespace {
 namespace mr = mipraster;
 using namespace helpers;
 
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
-}
-
-mr::Camera camera(mr::DepthConvention convention, int W, int H) {
-    const glm::dmat4 view = mr::look_at({0.3, 0.8, 4.0}, {0, 0, 0}, {0, 1, 0});
-    const double far = convention == mr::DepthConvention::opengl ? 20.0 : mr::kInfiniteFar;
-    return mr::Camera::from_matrices(view, mr::perspective(1.0, double(W) / H, 0.05, far, convention), convention);
-}
-
 /// Large random triangles crossing each other at random depths (some cross the near plane, so
 /// clipped pieces take part), with uvs spanning several texture periods.
 mr::Mesh overlapping(std::size_t n, double size, std::uint64_t seed) {
@@ -79,7 +69,7 @@ TEST(DeferredShading, SameBitsAsShadingWhileRasterizingOnOverlappingScenes) {
     anisotropic.footprint = mr::FootprintFilter::anisotropic;
     bilinear.mip_filter = mr::MipFilter::none;  // no derivatives: the fixed texturing kernel
     for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
-        const mr::Camera cam = camera(convention, W, H);
+        const mr::Camera cam = overlap_camera(convention, W, H);
         for (int samples : {1, 4})
             for (mr::Interpolation interpolation :
                  {mr::Interpolation::perspective, mr::Interpolation::screen, mr::Interpolation::flat}) {
@@ -120,7 +110,7 @@ TEST(DeferredShading, ShadesEachDrawnSampleExactlyOnce) {
     for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl})
         for (int samples : {1, 4}) {
             SCOPED_TRACE(mr::to_string(convention) + ", " + std::to_string(samples) + " samples");
-            const mr::Camera cam = camera(convention, W, H);
+            const mr::Camera cam = overlap_camera(convention, W, H);
             const float clear_depth = convention == mr::DepthConvention::opengl ? 1.0f : 0.0f;
             const mr::RenderResult r = mr::render({make_draw(a, glm::dmat4(1.0), mr::DrawState{})}, cam, settings(W, H, samples));
             ASSERT_EQ(r.stats.tiles_deferred, std::uint64_t((W / 32) * (H / 32)));  // every tile is deep here
@@ -134,7 +124,7 @@ TEST(DeferredShading, ShadesEachDrawnSampleExactlyOnce) {
 TEST(DeferredShading, TileBuffersAndListedPixelsGiveTheForwardImage) {
     const int W = 70, H = 50;
     const mr::Mesh a = overlapping(200, 2.5, 51);
-    const mr::Camera cam = camera(mr::DepthConvention::reverse_z, W, H);
+    const mr::Camera cam = overlap_camera(mr::DepthConvention::reverse_z, W, H);
     std::vector<mr::Draw> draws = {make_draw(a, glm::dmat4(1.0), mr::DrawState{})};
     draws[0].texture = checker_texture();
     std::vector<std::uint32_t> pixels;
@@ -157,7 +147,7 @@ TEST(DeferredShading, TileBuffersAndListedPixelsGiveTheForwardImage) {
 TEST(DeferredShading, BlendingMsaaAndShallowScenesShadeWhileRasterizing) {
     const int W = 64, H = 64;
     const mr::Mesh deep = overlapping(200, 2.5, 61), shallow = overlapping(3, 0.3, 62);
-    const mr::Camera cam = camera(mr::DepthConvention::reverse_z, W, H);
+    const mr::Camera cam = overlap_camera(mr::DepthConvention::reverse_z, W, H);
     mr::DrawState over;
     over.blend = mr::BlendMode::over;
     struct Case {

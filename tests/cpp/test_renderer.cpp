@@ -31,10 +31,6 @@ mr::Mesh random_triangles(std::size_t n, double size, std::uint64_t seed) {
     return helpers::random_triangles(n, size, seed, {-2.0, -1.5, -2.0}, {4.0, 3.0, 8.0});
 }
 
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
-}
-
 TEST(Renderer, OneTwoAndFourThreadsGiveBitIdenticalColourAndDepthForEveryBlendModeSsaaAndMsaa) {
     const int W = 160, H = 120;
     const mr::Camera cam = mr::Camera::look_at_perspective({0.3, 1.0, 4.0}, {0, 0, 0}, {0, 1, 0}, 1.0, double(W) / H, 0.05);
