@@ -27,6 +27,48 @@ void require_size(const Image& map, const Image& color, const char* name) {
 // A uniform double in [0, 1) from the generator.
 double uniform01(std::uint64_t& state) { return static_cast<double>(splitmix64(state) >> 11) * 0x1p-53; }
 
+// Step 1: `pixels` draws, i.i.d. from p_i = ½/N + ½·g_i/Σg over the guide g, with no reference
+// passes yet.
+ProbeReference draw_probe_pixels(const Image& g, int pixels, std::uint64_t seed) {
+    const std::size_t n_all = static_cast<std::size_t>(g.width) * g.height;
+    ProbeReference r;
+    r.width = g.width;
+    r.height = g.height;
+    r.seed = seed;
+    double total = 0.0;
+    for (const float v : g.pixels) total += v;
+    std::vector<double> cdf(n_all);
+    double running = 0.0;
+    for (std::size_t i = 0; i < n_all; ++i) {
+        running += total > 0.0 ? 0.5 / double(n_all) + 0.5 * g.pixels[i] / total : 1.0 / double(n_all);
+        cdf[i] = running;
+    }
+    std::uint64_t state = seed;
+    state = splitmix64(state) ^ ((std::uint64_t(std::uint32_t(g.width)) << 32) | std::uint32_t(g.height));
+    state = splitmix64(state) ^ std::uint64_t(std::uint32_t(pixels));
+    r.chosen.resize(static_cast<std::size_t>(pixels));
+    for (std::uint32_t& c : r.chosen) {
+        const std::size_t i = static_cast<std::size_t>(
+            std::upper_bound(cdf.begin(), cdf.end(), uniform01(state) * running) - cdf.begin());
+        c = static_cast<std::uint32_t>(std::min(i, n_all - 1));
+    }
+    r.distinct = r.chosen;
+    std::sort(r.distinct.begin(), r.distinct.end());
+    r.distinct.erase(std::unique(r.distinct.begin(), r.distinct.end()), r.distinct.end());
+    // The probability of each draw, and where its pixel's reference is kept.
+    r.probability.resize(r.chosen.size());
+    r.slot.resize(r.chosen.size());
+    for (std::size_t k = 0; k < r.chosen.size(); ++k) {
+        const std::size_t i = r.chosen[k];
+        r.probability[k] = (cdf[i] - (i ? cdf[i - 1] : 0.0)) / running;
+        r.slot[k] = static_cast<std::size_t>(std::lower_bound(r.distinct.begin(), r.distinct.end(), r.chosen[k]) -
+                                             r.distinct.begin());
+    }
+    r.mean.assign(r.distinct.size() * 3, 0.0);
+    r.m2.assign(r.distinct.size() * 3, 0.0);
+    return r;
+}
+
 // The estimate from what the passes gave so far.
 struct Estimate {
     double mse = 0, mse_se = 0;  // the image's MSE and its standard error
@@ -135,45 +177,7 @@ ErrorProbe measure_error(const std::vector<Draw>& draws, const Camera& camera, c
                                     std::to_string(reuse->height) + " image, got " + color.to_string());
     ProbeReference fresh;
     ProbeReference& r = reuse ? *reuse : fresh;
-    if (r.empty()) {
-        r = ProbeReference{};
-        r.width = w;
-        r.height = color.height;
-        r.seed = seed;
-        // Step 1: the draws, i.i.d. from p_i = ½/N + ½·g_i/Σg.
-        const Image g = guide ? *guide : error_guide(color, halves_map);
-        double total = 0.0;
-        for (const float v : g.pixels) total += v;
-        std::vector<double> cdf(n_all);
-        double running = 0.0;
-        for (std::size_t i = 0; i < n_all; ++i) {
-            running += total > 0.0 ? 0.5 / double(n_all) + 0.5 * g.pixels[i] / total : 1.0 / double(n_all);
-            cdf[i] = running;
-        }
-        std::uint64_t state = seed;
-        state = splitmix64(state) ^ ((std::uint64_t(std::uint32_t(w)) << 32) | std::uint32_t(color.height));
-        state = splitmix64(state) ^ std::uint64_t(std::uint32_t(pixels));
-        r.chosen.resize(static_cast<std::size_t>(pixels));
-        for (std::uint32_t& c : r.chosen) {
-            const std::size_t i = static_cast<std::size_t>(
-                std::upper_bound(cdf.begin(), cdf.end(), uniform01(state) * running) - cdf.begin());
-            c = static_cast<std::uint32_t>(std::min(i, n_all - 1));
-        }
-        r.distinct = r.chosen;
-        std::sort(r.distinct.begin(), r.distinct.end());
-        r.distinct.erase(std::unique(r.distinct.begin(), r.distinct.end()), r.distinct.end());
-        // The probability of each draw, and where its pixel's reference is kept.
-        r.probability.resize(r.chosen.size());
-        r.slot.resize(r.chosen.size());
-        for (std::size_t k = 0; k < r.chosen.size(); ++k) {
-            const std::size_t i = r.chosen[k];
-            r.probability[k] = (cdf[i] - (i ? cdf[i - 1] : 0.0)) / running;
-            r.slot[k] = static_cast<std::size_t>(std::lower_bound(r.distinct.begin(), r.distinct.end(), r.chosen[k]) -
-                                                 r.distinct.begin());
-        }
-        r.mean.assign(r.distinct.size() * 3, 0.0);
-        r.m2.assign(r.distinct.size() * 3, 0.0);
-    }
+    if (r.empty()) r = draw_probe_pixels(guide ? *guide : error_guide(color, halves_map), pixels, seed);
     const std::vector<std::uint32_t>& chosen = r.chosen;
     const std::vector<std::uint32_t>& distinct = r.distinct;
     const std::vector<double>& p = r.probability;

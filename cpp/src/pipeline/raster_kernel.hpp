@@ -242,7 +242,9 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
     const SamplePattern& pattern = *target.pattern;
     const int S = target.color.samples;
     const std::vector<OwnerRef>& refs = *target.owner_refs;
-    std::int32_t cached = -1;  // the owner whose per-triangle values are below
+    // The owner of this draw whose triangle and per-triangle values are below (−1: none yet).
+    std::int32_t cached = -1;
+    OwnerRef ref{};
     VertexValues colors{};
     TriangleUvs uvs{};
     for (int py = target.y0; py < target.y1; ++py)
@@ -250,24 +252,26 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
             float* const color_px = target.color.at(px, py, 0);
             for (int s = 0; s < S; ++s) {
                 const std::int32_t owner = target.owners[target.owner_index(px, py, s, S)];
-                if (owner < 0 || refs[static_cast<std::size_t>(owner)].triangle->draw != draw_index) continue;
-                const SetupTriangle& t = *refs[static_cast<std::size_t>(owner)].triangle;
-                const ClipWeights* const clip_weights = refs[static_cast<std::size_t>(owner)].clip_weights;
+                if (owner < 0) continue;
                 if (owner != cached) {
+                    const OwnerRef& next = refs[static_cast<std::size_t>(owner)];
+                    if (next.triangle->draw != draw_index) continue;
                     cached = owner;
-                    if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective) {
-                        const glm::uvec3 tri = draw.triangles[t.triangle];
+                    ref = next;
+                    const glm::uvec3 tri = draw.triangles[ref.triangle->triangle];
+                    if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective)
                         colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
-                    }
-                    if constexpr (kTexturing != Texturing::none) uvs = TriangleUvs(t, draw.triangles[t.triangle], draw.uvs, clip_weights);
+                    if constexpr (kTexturing != Texturing::none) uvs = TriangleUvs(*ref.triangle, tri, draw.uvs, ref.clip_weights);
                 }
+                const SetupTriangle& t = *ref.triangle;
                 const std::int64_t X = std::int64_t{px} * kSubpixelOne + pattern.x[s];
                 const std::int64_t Y = std::int64_t{py} * kSubpixelOne + pattern.y[s];
                 const glm::dvec3 l = screen_weights(t, t.edge_a[0] * X + t.edge_b[0] * Y + t.edge_c[0],
                                                     t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1],
                                                     t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2]);
                 ++counters.shader_invocations;
-                blend_into<BlendMode::replace>(color_px + 4 * s, shade<kShading, kTexturing>(draw, colors, uvs, t, l, clip_weights, px, py));
+                blend_into<BlendMode::replace>(color_px + 4 * s,
+                                               shade<kShading, kTexturing>(draw, colors, uvs, t, l, ref.clip_weights, px, py));
             }
         }
 }
