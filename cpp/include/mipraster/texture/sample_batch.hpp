@@ -1,0 +1,65 @@
+#pragma once
+// Texture lookups eight at a time: the footprint, λ and texel positions of all eight in float
+// vectors, then one trilinear blend per lookup. The fast path for the common samplers (bilinear
+// and trilinear, repeat or clamp); sample_texture (sample.hpp, double positions) stays the
+// reference it is tested against.
+#include <cstdint>
+
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+#include "mipraster/texture/sampler.hpp"
+#include "mipraster/texture/texture.hpp"
+
+namespace mipraster {
+
+inline constexpr int kLookupBatch = 8;
+
+/// Up to kLookupBatch lookups, one per lane: what sample_texture takes, as arrays.
+struct LookupBatch {
+    float u[kLookupBatch], v[kLookupBatch];
+    float dudx[kLookupBatch], dvdx[kLookupBatch], dudy[kLookupBatch], dvdy[kLookupBatch];
+    int count = 0;
+
+    void set(int lane, glm::vec2 uv, glm::vec2 duv_dx, glm::vec2 duv_dy) {
+        u[lane] = uv.x, v[lane] = uv.y;
+        dudx[lane] = duv_dx.x, dvdx[lane] = duv_dx.y, dudy[lane] = duv_dy.x, dvdy[lane] = duv_dy.y;
+    }
+};
+
+/// How far a batched lookup may be from sample_texture, per channel, in units of the largest
+/// |texel value| of level 0: λ in float moves the blend between two levels by ≤ 4·10⁻⁶, and a
+/// texel position u·w in float is off by ≤ w·2⁻²⁴ texels (exact for a power-of-two width).
+inline double batch_sampling_tolerance(int width, int height) {
+    const int longest = width > height ? width : height;
+    return 4e-6 + longest * 0x1p-22;
+}
+
+/// Samples one texture with one sampler a batch at a time. Lookups the float path handles (see
+/// covers()) go through it; every other lane (a non-finite uv or derivative, an anisotropic
+/// footprint that needs more than one probe, a sampler outside covers()) calls sample_texture,
+/// so its value is the reference's exactly. The result depends on neither the CPU nor the
+/// batch's other lanes (plain vector arithmetic, no fused multiply-add).
+class BatchSampler {
+public:
+    /// `texture` must outlive the sampler (the levels it reads are pinned by the view).
+    BatchSampler(const TextureView& texture, const Sampler& sampler);
+
+    /// True when the sampler is one the float path takes: linear magnification and
+    /// minification, mip filter none or linear, an isotropic or anisotropic footprint, repeat
+    /// or clamp on both axes. False: every lane is a sample_texture call.
+    static bool covers(const Sampler& sampler);
+
+    /// out[i] for i < batch.count.
+    void sample(const LookupBatch& batch, glm::vec4* out);
+
+private:
+    const TextureView& texture_;
+    Sampler sampler_;
+    bool covered_;
+    // Texels of the levels read so far (null: not asked for yet; asking may build it).
+    const glm::vec4* level_texels_[32] = {};
+    const glm::vec4* level(int k);
+};
+
+}  // namespace mipraster
