@@ -4,8 +4,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
+
+#include "texel.hpp"
 
 namespace mipraster {
 
@@ -16,23 +17,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // error; log2 turns that into ~1e-7 absolute).
 constexpr double kLodSnap = 1e-6;
 
-// One RGBA texel in one SSE register. A GCC/Clang vector type: the same SSE2 instructions on
-// every x86-64, so results do not depend on the CPU (DESIGN.md §2.8).
-typedef float Texel __attribute__((vector_size(16)));
-
-inline Texel load(const glm::vec4& t) {
-    Texel r;
-    std::memcpy(&r, &t, sizeof r);
-    return r;
-}
-inline glm::vec4 to_vec4(Texel t) {
-    glm::vec4 r;
-    std::memcpy(&r, &t, sizeof r);
-    return r;
-}
-inline Texel splat(float x) { return Texel{x, x, x, x}; }
-// a + t·(b − a): equal a and b give back a exactly, whatever t is.
-inline Texel lerp(Texel a, Texel b, float t) { return a + splat(t) * (b - a); }
+using namespace texel;
 
 // ⌊x⌋ and ⌈x⌉ of a finite x well inside the int range (callers bound x first): a truncation and a
 // compare, where std::floor is a library call on the x86-64 baseline.
@@ -108,11 +93,6 @@ Texel nearest(const TextureLevel& level, double u, double v, const Sampler& s) {
     const double x = reduce(u * level.width, level.width, s.wrap_u);
     const double y = reduce(v * level.height, level.height, s.wrap_v);
     return fetch(level, floor_int(x), floor_int(y), s);
-}
-
-// The bilinear blend of four texels a b / c d at fractions (ax, ay).
-inline Texel lerp_quad(Texel a, Texel b, Texel c, Texel d, float ax, float ay) {
-    return lerp(lerp(a, b, ax), lerp(c, d, ax), ay);
 }
 
 // The quad at (i, j) when part of it lies outside the texture: each texel wrapped on its own.
@@ -247,7 +227,7 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
         p.magnifies = p.lambda <= 0.0;
         return p;
     }
-    const double pmax2 = std::max(px2, py2), pmin2 = std::min(px2, py2);
+    const double pmax2 = std::max(px2, py2);
     if (plainly_magnifies(pmax2, s)) {
         p.magnifies = true;
         return p;
@@ -260,15 +240,7 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
         p.magnifies = true;
         return p;
     }
-    // max_anisotropy is any finite float ≥ 1: bound it before the int conversion (UB beyond 2³¹).
-    const int max_n = static_cast<int>(std::clamp(double(s.max_anisotropy), 1.0, double(kMostProbes)));
-    // ⌈Pmax/Pmin⌉ from the squares; Pmin = 0 gives ∞ or NaN, both max_n.
-    if (pmax2 == pmin2 && pmin2 > 0.0) {  // isotropic: neither the division nor the root
-        p.count = 1;
-    } else {
-        const double ratio2 = pmax2 / pmin2;
-        p.count = ratio2 < double(max_n) * max_n ? std::max(1, ceil_int(std::sqrt(ratio2))) : max_n;
-    }
+    p.count = anisotropic_probe_count(px2, py2, s.max_anisotropy);
     p.lambda = lod_from_log2_size(p.count == 1 ? log2_pmax : log2_pmax - kLog2Count[p.count], s, levels);
     const glm::vec2 major = px2 >= py2 ? dx : dy;
     p.du = major.x;
@@ -462,6 +434,16 @@ const GaussianTable kGaussian;
 }
 
 }  // namespace
+
+int anisotropic_probe_count(double px2, double py2, float max_anisotropy) {
+    const double pmax2 = std::max(px2, py2), pmin2 = std::min(px2, py2);
+    // max_anisotropy is any finite float ≥ 1: bound it before the int conversion (UB beyond 2³¹).
+    const int max_n = static_cast<int>(std::clamp(double(max_anisotropy), 1.0, double(kMostProbes)));
+    // ⌈Pmax/Pmin⌉ from the squares; Pmin = 0 gives ∞ or NaN, both max_n.
+    if (pmax2 == pmin2 && pmin2 > 0.0) return 1;  // isotropic: neither the division nor the root
+    const double ratio2 = pmax2 / pmin2;
+    return ratio2 < double(max_n) * max_n ? std::max(1, ceil_int(std::sqrt(ratio2))) : max_n;
+}
 
 double texture_lod(const TextureView& t, const Sampler& s, glm::vec2 dx, glm::vec2 dy) {
     const Footprint f = texel_footprint(t, dx, dy);

@@ -26,6 +26,10 @@ inline constexpr double kEwaAlpha = 6.0;
 /// λ ≤ 0 means magnification (the mag filter on level 0).
 double texture_lod(const TextureView& texture, const Sampler& sampler, glm::vec2 duv_dx, glm::vec2 duv_dy);
 
+/// How many probes an anisotropic lookup takes for the squared lengths px2, py2 of its derivative
+/// vectors in level-0 texels (finite): min(⌈Pmax/Pmin⌉, max anisotropy), 1 when they are equal.
+int anisotropic_probe_count(double px2, double py2, float max_anisotropy);
+
 /// The filtered, premultiplied linear RGBA colour at uv (0,0 = top-left of the first row) for
 /// a pixel whose uv changes by duv_dx, duv_dy per pixel step. A non-finite uv returns the border
 /// colour. Positions, fractions and λ are computed in double; texels are blended in float, four

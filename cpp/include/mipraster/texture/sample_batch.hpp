@@ -16,9 +16,10 @@ namespace mipraster {
 inline constexpr int kLookupBatch = 8;
 
 /// Up to kLookupBatch lookups, one per lane: what sample_texture takes, as arrays.
+/// Lanes past `count` are read but not used (zero-initialized, so they hold defined values).
 struct LookupBatch {
-    float u[kLookupBatch], v[kLookupBatch];
-    float dudx[kLookupBatch], dvdx[kLookupBatch], dudy[kLookupBatch], dvdy[kLookupBatch];
+    float u[kLookupBatch] = {}, v[kLookupBatch] = {};
+    float dudx[kLookupBatch] = {}, dvdx[kLookupBatch] = {}, dudy[kLookupBatch] = {}, dvdy[kLookupBatch] = {};
     int count = 0;
 
     void set(int lane, glm::vec2 uv, glm::vec2 duv_dx, glm::vec2 duv_dy) {
@@ -59,7 +60,8 @@ private:
     bool covered_;
     // Texels of the levels read so far (null: not asked for yet; asking may build it).
     const glm::vec4* level_texels_[32] = {};
-    const glm::vec4* level(int k);
+    const glm::vec4* level(int k) { return level_texels_[k] ? level_texels_[k] : first_use(k); }
+    const glm::vec4* first_use(int k);
 };
 
 }  // namespace mipraster

@@ -1,0 +1,216 @@
+#include "mipraster/texture/sample_batch.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "mipraster/texture/sample.hpp"
+#include "texel.hpp"
+
+namespace mipraster {
+
+namespace {
+
+using namespace texel;
+
+// Four lanes at a time in GCC/Clang vector types, one SSE2 register on the x86-64 baseline: the
+// same arithmetic on every CPU (DESIGN.md §2.8; -ffp-contract=off keeps multiply and add apart).
+// (Eight-lane types are split element by element by GCC on the baseline: far slower.)
+constexpr int kWidth = 4;
+typedef float Floats __attribute__((vector_size(16)));
+typedef std::int32_t Ints __attribute__((vector_size(16)));
+
+inline Floats splat_f(float x) { return Floats{} + x; }
+inline Floats min_v(Floats a, Floats b) { return a < b ? a : b; }
+inline Floats max_v(Floats a, Floats b) { return a > b ? a : b; }
+inline Floats clamp_v(Floats x, Floats lo, Floats hi) { return min_v(max_v(x, lo), hi); }
+inline Ints min_v(Ints a, Ints b) { return a < b ? a : b; }
+inline Ints max_v(Ints a, Ints b) { return a > b ? a : b; }
+inline Ints to_int(Floats x) { return __builtin_convertvector(x, Ints); }  // truncation
+inline Floats to_float(Ints x) { return __builtin_convertvector(x, Floats); }
+// ⌊x⌋ of |x| < 2³¹ (callers bound x first): truncate, then step down where that rounded up.
+inline Ints floor_v(Floats x) {
+    const Ints i = to_int(x);
+    return i + (to_float(i) > x);  // a true compare is −1
+}
+template <typename To, typename From>
+inline To bits_as(From x) {
+    static_assert(sizeof(To) == sizeof(From));
+    To r;
+    std::memcpy(&r, &x, sizeof r);
+    return r;
+}
+inline Floats load_f(const float* p) {
+    Floats r;
+    std::memcpy(&r, p, sizeof r);
+    return r;
+}
+
+// log2 x of a positive normal x: the exponent plus log2 of the mantissa m ∈ [√½, √2) from the
+// series 2·atanh(s)/ln 2, s = (m − 1)/(m + 1), |s| ≤ 0.172, to s⁹ (the next term is < 4·10⁻¹⁰).
+// Exact at powers of two, so a 2^k footprint gives λ = k as the double path does.
+[[gnu::always_inline]] inline Floats log2_v(Floats x) {
+    const Ints bits = bits_as<Ints>(x);
+    Ints e = ((bits >> 23) & 0xff) - 127;
+    const Ints mantissa_bits = (bits & 0x7fffff) | 0x3f800000;
+    Floats m = bits_as<Floats>(mantissa_bits);
+    const Ints high = m > splat_f(1.41421356f);
+    m = high ? m * 0.5f : m;
+    e -= high;  // (−1 where true)
+    const Floats s = (m - 1.0f) / (m + 1.0f), s2 = s * s;
+    constexpr float k = 2.0f / 0.693147180559945309f;  // 2 / ln 2
+    const Floats series = s * (k + s2 * (k / 3 + s2 * (k / 5 + s2 * (k / 7 + s2 * (k / 9)))));
+    return to_float(e) + series;
+}
+
+// Per lane, what the blend needs: which level(s), the weight of the finer one's neighbour,
+// the texel indices of the bilinear quads and their fractions.
+struct LanePlan {
+    std::int32_t level[kLookupBatch];
+    float level_weight[kLookupBatch];  // > 0: blend towards level + 1
+    std::int32_t texel[2][4][kLookupBatch];  // per level: the quad's texels a b / c d
+    float fx[2][kLookupBatch], fy[2][kLookupBatch];
+    std::int32_t finite[kLookupBatch];  // 0: the lane is sample_texture's (−1: all inputs finite)
+};
+
+// Texel indices and fractions along one axis at level sizes n (float and int, per lane), for a
+// bilinear quad at x = coordinate·n − ½; repeat or clamp.
+[[gnu::always_inline]] inline void axis(Floats coordinate, Floats n, Ints n_int, WrapMode mode, Ints& lo, Ints& hi, Floats& fraction) {
+    Floats x;
+    if (mode == WrapMode::repeat) {
+        // frac(coordinate) is exact (and so is its product with a power-of-two size); from 2²³ on
+        // a float holds no fraction, and is kept away from the int conversion.
+        const Ints whole_number = (coordinate >= splat_f(0x1p23f)) | (coordinate <= splat_f(-0x1p23f));
+        const Floats bounded = whole_number ? splat_f(0.0f) : coordinate;
+        x = (bounded - to_float(floor_v(bounded))) * n - 0.5f;
+    } else {
+        x = clamp_v(coordinate * n, splat_f(-2.0f), n + 2.0f) - 0.5f;
+    }
+    const Ints i = floor_v(x);
+    fraction = x - to_float(i);
+    if (mode == WrapMode::repeat) {
+        lo = i < 0 ? i + n_int : i;
+        hi = i + 1 >= n_int ? i + 1 - n_int : i + 1;
+    } else {
+        const Ints last = n_int - 1, zero = Ints{};
+        lo = min_v(max_v(i, zero), last);
+        hi = min_v(max_v(i + 1, zero), last);
+    }
+}
+
+// Lanes first … first + kWidth − 1 of the plan: whether they are finite, their level(s) and
+// the bilinear quads on them.
+void plan_lanes(const LookupBatch& b, int first, const Sampler& s, int width_texels, int height_texels, int levels,
+                LanePlan& plan) {
+    Floats u = load_f(first + b.u), v = load_f(first + b.v);
+    const Floats width = splat_f(static_cast<float>(width_texels)), height = splat_f(static_cast<float>(height_texels));
+    const Floats ux = load_f(first + b.dudx) * width, vx = load_f(first + b.dvdx) * height;
+    const Floats uy = load_f(first + b.dudy) * width, vy = load_f(first + b.dvdy) * height;
+    const Floats px2 = ux * ux + vx * vx, py2 = uy * uy + vy * vy;
+    // Lanes for the reference: a non-finite uv, derivative or squared length (NaN fails every
+    // compare; an overflow to ∞ fails < max).
+    constexpr float kMax = std::numeric_limits<float>::max();
+    const Floats finite_check = (u - u) + (v - v) + px2 + py2;  // NaN or ∞ unless all finite
+    const Ints finite = (finite_check < splat_f(kMax)) & (finite_check > splat_f(-kMax));
+    // Those lanes' positions are not used: zero keeps every conversion below defined.
+    u = finite ? u : splat_f(0.0f);
+    v = finite ? v : splat_f(0.0f);
+
+    Floats lambda = splat_f(0.0f);
+    if (s.needs_derivatives() && s.mip_filter == MipFilter::linear) {
+        // λ as lod_from_log2_size computes it, in float: log2 ρ + bias, bounded, snapped to an
+        // integer within 10⁻⁶, clamped to [min_lod, max_lod] and [0, levels − 1].
+        const Floats rho2 = max_v(px2, py2);
+        constexpr float kTiny = 0x1p-100f;  // below: log2 ρ = −∞ (what log2 0 gives in double)
+        Floats log2_rho = 0.5f * log2_v(max_v(rho2, splat_f(kTiny)));
+        log2_rho = rho2 < splat_f(kTiny) ? splat_f(-std::numeric_limits<float>::infinity()) : log2_rho;
+        lambda = clamp_v(log2_rho + s.lod_bias, splat_f(-1.0f), splat_f(static_cast<float>(levels)));
+        const Floats nearest_integer = to_float(floor_v(lambda + 0.5f));
+        const Floats distance = lambda - nearest_integer;
+        lambda = (distance < splat_f(1e-6f)) & (distance > splat_f(-1e-6f)) ? nearest_integer : lambda;
+        lambda = clamp_v(lambda, splat_f(s.min_lod), splat_f(s.max_lod));
+        lambda = clamp_v(lambda, splat_f(0.0f), splat_f(static_cast<float>(levels - 1)));
+    }
+    const Ints fine = to_int(lambda);  // λ ∈ [0, levels − 1]: truncation is the floor
+    Floats weight = lambda - to_float(fine);
+    weight = fine + 1 < levels ? weight : splat_f(0.0f);
+    std::memcpy(plan.level + first, &fine, sizeof fine);
+    std::memcpy(plan.level_weight + first, &weight, sizeof weight);
+
+    // Both levels' quads: level k and k + 1 (sizes max(1, ⌊w/2^k⌋), exact in float).
+    for (int step = 0; step < 2; ++step) {
+        const Ints k = min_v(fine + step, Ints{} + (levels - 1));
+        const Ints scale_bits = (127 - k) << 23;
+        const Floats scale = bits_as<Floats>(scale_bits);  // 2^−k
+        const Floats wk = max_v(to_float(to_int(width * scale)), splat_f(1.0f));
+        const Floats hk = max_v(to_float(to_int(height * scale)), splat_f(1.0f));
+        Ints i0, i1, j0, j1;
+        Floats fx, fy;
+        axis(u, wk, to_int(wk), s.wrap_u, i0, i1, fx);
+        axis(v, hk, to_int(hk), s.wrap_v, j0, j1, fy);
+        const Ints wk_int = to_int(wk);
+        const Ints row0 = j0 * wk_int, row1 = j1 * wk_int;
+        const Ints quad[4] = {row0 + i0, row0 + i1, row1 + i0, row1 + i1};
+        for (int c = 0; c < 4; ++c) std::memcpy(plan.texel[step][c] + first, &quad[c], sizeof quad[c]);
+        std::memcpy(plan.fx[step] + first, &fx, sizeof fx);
+        std::memcpy(plan.fy[step] + first, &fy, sizeof fy);
+        if (!s.needs_derivatives() || s.mip_filter != MipFilter::linear) break;  // level 0 only
+    }
+    std::memcpy(plan.finite + first, &finite, sizeof finite);
+}
+
+}  // namespace
+
+BatchSampler::BatchSampler(const TextureView& texture, const Sampler& sampler)
+    : texture_(texture), sampler_(sampler), covered_(covers(sampler)) {}
+
+bool BatchSampler::covers(const Sampler& s) {
+    const auto wrap = [](WrapMode m) { return m == WrapMode::repeat || m == WrapMode::clamp; };
+    return s.mag_filter == TexelFilter::linear && s.min_filter == TexelFilter::linear &&
+           (s.mip_filter == MipFilter::linear || s.mip_filter == MipFilter::none) &&
+           (s.footprint == FootprintFilter::isotropic || s.footprint == FootprintFilter::anisotropic) &&
+           wrap(s.wrap_u) && wrap(s.wrap_v);
+}
+
+const glm::vec4* BatchSampler::first_use(int k) { return level_texels_[k] = texture_.level(k).texels.data(); }
+
+void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
+    const int n = batch.count;
+    if (!covered_) {
+        for (int l = 0; l < n; ++l)
+            out[l] = sample_texture(texture_, sampler_, {batch.u[l], batch.v[l]}, {batch.dudx[l], batch.dvdx[l]},
+                                    {batch.dudy[l], batch.dvdy[l]});
+        return;
+    }
+    const LookupBatch& b = batch;
+
+    const Sampler& s = sampler_;
+    LanePlan plan;
+    for (int first = 0; first < kLookupBatch; first += kWidth)
+        plan_lanes(b, first, s, texture_.width(), texture_.height(), texture_.level_count(), plan);
+    for (int l = 0; l < n; ++l) {
+        bool reference = !plan.finite[l];
+        // An anisotropic footprint is one lookup only when it needs one probe (decided in double,
+        // as sample_texture decides it).
+        if (!reference && s.footprint == FootprintFilter::anisotropic) {
+            const double dux = double(b.dudx[l]) * texture_.width(), dvx = double(b.dvdx[l]) * texture_.height();
+            const double duy = double(b.dudy[l]) * texture_.width(), dvy = double(b.dvdy[l]) * texture_.height();
+            reference = anisotropic_probe_count(dux * dux + dvx * dvx, duy * duy + dvy * dvy, s.max_anisotropy) > 1;
+        }
+        if (reference) {
+            out[l] = sample_texture(texture_, s, {b.u[l], b.v[l]}, {b.dudx[l], b.dvdx[l]}, {b.dudy[l], b.dvdy[l]});
+            continue;
+        }
+        const auto quad = [&](int step) {
+            const glm::vec4* t = level(plan.level[l] + step);
+            const std::int32_t(&q)[4][kLookupBatch] = plan.texel[step];
+            return lerp_quad(load(t[q[0][l]]), load(t[q[1][l]]), load(t[q[2][l]]), load(t[q[3][l]]), plan.fx[step][l],
+                             plan.fy[step][l]);
+        };
+        Texel c = quad(0);
+        if (plan.level_weight[l] > 0.0f) c = lerp(c, quad(1), plan.level_weight[l]);
+        out[l] = to_vec4(c);
+    }
+}
+
+}  // namespace mipraster
