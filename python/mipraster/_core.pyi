@@ -180,6 +180,7 @@ class RenderSettings:
     keep_samples: bool
     depth_output: bool
     deferred_shading: bool
+    batched_lookups: bool
     derivatives: str
     debug_view: str
     resolve_filter: str

@@ -133,7 +133,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
            keep_samples: bool = False, depth: bool = True, derivatives: str = "analytic",
            debug_view: str = "none", resolve_filter: str = "box", estimate_error: bool = False,
            target_error: Optional[float] = None, probe_pixels: Optional[int] = None,
-           deferred_shading: bool = True) -> RenderResult:
+           deferred_shading: bool = True, batched_lookups: bool = True) -> RenderResult:
     """Renders ``scene`` through ``camera`` into a ``width`` × ``height`` image.
 
     Args:
@@ -197,6 +197,12 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             what lies beneath (1 sample or SSAA), find each sample's visible triangle first and
             shade it once (``stats["tiles_deferred"]`` counts those tiles). The image is the same
             bit for bit; False shades every sample that passes its depth test, for comparison.
+        batched_lookups: textured draws whose sampler is bilinear or trilinear (isotropic, or
+            anisotropic where a footprint needs one probe) with repeat or clamp wrapping look
+            their texture up eight samples at a time in float. Each lookup is within
+            (4e-6 + 2^-22 × the texture's longer side in texels) × its largest texel value of the
+            double-precision reference: 2.5e-4 for 1024 texels, and nearer 1e-7 in practice for
+            power-of-two sizes. False uses the reference for every sample, for comparison.
 
     Returns:
         A :class:`RenderResult`.
@@ -222,6 +228,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     keep = _checks.flag(keep_samples, "keep_samples")
     depth_output = _checks.flag(depth, "depth")
     deferred = _checks.flag(deferred_shading, "deferred_shading")
+    batched = _checks.flag(batched_lookups, "batched_lookups")
     derivative_mode = _checks.choice(derivatives, "derivatives", DERIVATIVES)
     debug = _checks.choice(debug_view, "debug_view", DEBUG_VIEWS)
     resolve = _checks.choice(resolve_filter, "resolve_filter", {f: f for f in RESAMPLE_FILTERS})
@@ -249,6 +256,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
     settings.anti_aliasing, settings.pattern, settings.pattern_seed = anti_aliasing, pattern_kind, pattern_seed
     settings.threads, settings.clear_color, settings.keep_samples = n_threads, clear, keep
     settings.depth_output, settings.deferred_shading = depth_output, deferred
+    settings.batched_lookups = batched
     settings.derivatives, settings.debug_view = derivative_mode, debug
     settings.resolve_filter = resolve
     settings.estimate_error = (estimate or target_error is not None) and samples >= 2

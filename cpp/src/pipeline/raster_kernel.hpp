@@ -4,6 +4,7 @@
 // of texturing is instantiated in its own source file so they compile in parallel.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "mipraster/core/constants.hpp"
 #include "mipraster/pipeline/blend.hpp"
@@ -11,6 +12,7 @@
 #include "mipraster/pipeline/rasterize_tile.hpp"
 #include "mipraster/pipeline/shade_texture.hpp"
 #include "mipraster/texture/sample.hpp"
+#include "lookup_queue.hpp"
 #include "tile_blocks.hpp"
 
 namespace mipraster {
@@ -23,10 +25,11 @@ inline bool depth_passes(float z, float stored) {
     else return true;
 }
 
-// The texture's contribution at screen weights l of pixel (px, py).
+// The texture lookup's inputs at screen weights l of pixel (px, py): uv and, for λ, its
+// derivatives (per pixel, or per sample cell under SSAA).
 template <Texturing kTexturing>
-inline glm::vec4 texture_colour(const DrawInputs& draw, const SetupTriangle& t, const TriangleUvs& uvs,
-                                const glm::dvec3& l, int px, int py) {
+inline UvSample texture_lookup(const DrawInputs& draw, const SetupTriangle& t, const TriangleUvs& uvs,
+                               const glm::dvec3& l, int px, int py) {
     constexpr bool kLod = kTexturing == Texturing::lod;
     UvSample s = interpolate_uv<kLod>(t, uvs, l, draw.uv_interpolation);
     if constexpr (kLod) {
@@ -35,6 +38,16 @@ inline glm::vec4 texture_colour(const DrawInputs& draw, const SetupTriangle& t, 
             s.dx *= draw.footprint_scale.x;
             s.dy *= draw.footprint_scale.y;
         }
+    }
+    return s;
+}
+
+// The texture's contribution at screen weights l of pixel (px, py), one reference lookup.
+template <Texturing kTexturing>
+inline glm::vec4 texture_colour(const DrawInputs& draw, const SetupTriangle& t, const TriangleUvs& uvs,
+                                const glm::dvec3& l, int px, int py) {
+    const UvSample s = texture_lookup<kTexturing>(draw, t, uvs, l, px, py);
+    if constexpr (kTexturing == Texturing::lod) {
         if (draw.debug_view == DebugView::uv)
             return glm::vec4(static_cast<float>(s.uv.x - std::floor(s.uv.x)), static_cast<float>(s.uv.y - std::floor(s.uv.y)),
                              0.0f, 1.0f);
@@ -44,6 +57,20 @@ inline glm::vec4 texture_colour(const DrawInputs& draw, const SetupTriangle& t, 
     return sample_texture(*draw.texture, *draw.sampler, glm::vec2(s.uv), glm::vec2(s.dx), glm::vec2(s.dy));
 }
 
+// The colour before texturing: the draw colour × the vertex colours.
+template <Shading kShading>
+inline glm::vec4 untextured_colour(const DrawInputs& draw, const VertexValues& colors, const SetupTriangle& t,
+                                   const glm::dvec3& screen, const ClipWeights* clip_weights) {
+    if constexpr (kShading == Shading::constant) {
+        return draw.color;
+    } else if constexpr (kShading == Shading::flat) {
+        return draw.color * colors.v[0];
+    } else {
+        const glm::dvec3 w = kShading == Shading::perspective ? perspective_weights(t, screen) : screen;
+        return draw.color * colors.interpolate(original_weights(t, w, clip_weights));
+    }
+}
+
 template <Shading kShading, Texturing kTexturing>
 inline glm::vec4 shade(const DrawInputs& draw, const VertexValues& colors, const TriangleUvs& uvs,
                        const SetupTriangle& t, const glm::dvec3& screen, const ClipWeights* clip_weights, int px,
@@ -51,17 +78,32 @@ inline glm::vec4 shade(const DrawInputs& draw, const VertexValues& colors, const
     if constexpr (kTexturing == Texturing::lod) {  // a debug view shows its colour unmodulated
         if (draw.debug_view != DebugView::none) return texture_colour<kTexturing>(draw, t, uvs, screen, px, py);
     }
-    glm::vec4 c;
-    if constexpr (kShading == Shading::constant) {
-        c = draw.color;
-    } else if constexpr (kShading == Shading::flat) {
-        c = draw.color * colors.v[0];
-    } else {
-        const glm::dvec3 w = kShading == Shading::perspective ? perspective_weights(t, screen) : screen;
-        c = draw.color * colors.interpolate(original_weights(t, w, clip_weights));
-    }
+    glm::vec4 c = untextured_colour<kShading>(draw, colors, t, screen, clip_weights);
     if constexpr (kTexturing != Texturing::none) c *= texture_colour<kTexturing>(draw, t, uvs, screen, px, py);
     return c;
+}
+
+// Shades samples `samples` of one pixel (colour slots at `target`) with one colour: through the
+// lookup queue when there is one (textured draws), else at once.
+template <BlendMode kBlend, Shading kShading, Texturing kTexturing>
+inline void shade_into(LookupQueue<kBlend>* queue, float* target, std::uint64_t samples, const DrawInputs& draw,
+                       const VertexValues& colors, const TriangleUvs& uvs, const SetupTriangle& t,
+                       const glm::dvec3& screen, const ClipWeights* clip_weights, int px, int py) {
+    if constexpr (kTexturing != Texturing::none) {
+        if (queue) {
+            queue->push(target, samples, untextured_colour<kShading>(draw, colors, t, screen, clip_weights),
+                        texture_lookup<kTexturing>(draw, t, uvs, screen, px, py));
+            return;
+        }
+    }
+    const glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, screen, clip_weights, px, py);
+    for (std::uint64_t m = samples; m; m &= m - 1) blend_into<kBlend>(target + 4 * __builtin_ctzll(m), c);
+}
+
+// True when a draw's texture lookups go through a lookup queue (debug views never do).
+template <Texturing kTexturing>
+inline bool queues_lookups(const DrawInputs& draw) {
+    return kTexturing != Texturing::none && draw.batched_lookups && draw.debug_view == DebugView::none;
 }
 
 template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode, Texturing kTexturing>
@@ -73,6 +115,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     const int S = kMode == SampleMode::single ? 1 : pattern.count();
     constexpr std::int64_t kStep = kSubpixelOne;  // one pixel in fixed point
     TileBlocks blocks(target, S);
+    std::optional<LookupQueue<kBlend>> queue;
+    if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
 
     for (std::size_t k = 0; k < batch.count; ++k) {
         const SetupTriangle& t = batch.tris[batch.indices[k]];
@@ -173,11 +217,9 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
                     counters.samples_passed += static_cast<std::uint64_t>(__builtin_popcountll(passed));
                     ++counters.shader_invocations;
-                    glm::vec4 color;
-                    if constexpr ((kShading == Shading::constant || kShading == Shading::flat) &&
-                                  kTexturing == Texturing::none) {
-                        color = shade<kShading, kTexturing>(draw, colors, uvs, t, glm::dvec3(0.0), batch.clip_weights, px, py);
-                    } else {
+                    glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
+                    if constexpr (!((kShading == Shading::constant || kShading == Shading::flat) &&
+                                    kTexturing == Texturing::none)) {
                         const std::int64_t half = kStep / 2;
                         std::int64_t c0 = p0 + (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * half;
                         std::int64_t c1 = p1 + (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * half;
@@ -188,11 +230,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             c1 = p1 + off1[s];
                             c2 = p2 + off2[s];
                         }
-                        color = shade<kShading, kTexturing>(draw, colors, uvs, t, screen_weights(t, c0, c1, c2),
-                                                            batch.clip_weights, px, py);
+                        l = screen_weights(t, c0, c1, c2);
                     }
-                    for (std::uint64_t m = passed; m; m &= m - 1)
-                        blend_into<kBlend>(color_px + 4 * __builtin_ctzll(m), color);
+                    shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px, passed, draw, colors, uvs,
+                                                             t, l, batch.clip_weights, px, py);
                 } else {
                     // Shade every covered sample that passes the depth test.
                     for (; covered; covered &= covered - 1) {
@@ -223,14 +264,16 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             target.barycentrics.data[2 * i + 1] = static_cast<float>(w.z);
                         } else {
                             ++counters.shader_invocations;
-                            blend_into<kBlend>(color_px + 4 * s,
-                                              shade<kShading, kTexturing>(draw, colors, uvs, t, l, batch.clip_weights, px, py));
+                            shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px,
+                                                                     std::uint64_t{1} << s, draw, colors, uvs, t, l,
+                                                                     batch.clip_weights, px, py);
                         }
                     }
                 }
             }
         }
     }
+    if (queue) queue->flush();
 }
 
 // Deferred shading's second pass (OwnedShadingKernel): each sample owned by a triangle of this
@@ -247,6 +290,8 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
     OwnerRef ref{};
     VertexValues colors{};
     TriangleUvs uvs{};
+    std::optional<LookupQueue<BlendMode::replace>> queue;
+    if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
     for (int py = target.y0; py < target.y1; ++py)
         for (int px = target.x0; px < target.x1; ++px) {
             float* const color_px = target.color.at(px, py, 0);
@@ -270,10 +315,12 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
                                                     t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1],
                                                     t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2]);
                 ++counters.shader_invocations;
-                blend_into<BlendMode::replace>(color_px + 4 * s,
-                                               shade<kShading, kTexturing>(draw, colors, uvs, t, l, ref.clip_weights, px, py));
+                shade_into<BlendMode::replace, kShading, kTexturing>(queue ? &*queue : nullptr, color_px,
+                                                                     std::uint64_t{1} << s, draw, colors, uvs, t, l,
+                                                                     ref.clip_weights, px, py);
             }
         }
+    if (queue) queue->flush();
 }
 
 template <Texturing T>

@@ -475,6 +475,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             inputs[d].uv_interpolation = interpolation;
             inputs[d].derivatives = settings.derivatives;
             inputs[d].debug_view = settings.debug_view;
+            inputs[d].batched_lookups = settings.batched_lookups;
             if (settings.anti_aliasing == AntiAliasing::ssaa && S > 1)
                 inputs[d].footprint_scale = glm::dvec2(1.0 / result.pattern.columns, 1.0 / result.pattern.rows);
         }
@@ -658,7 +659,7 @@ std::string RenderSettings::to_string() const {
            mipraster::to_string(resolve_filter) + ", derivatives=" + mipraster::to_string(derivatives) +
            ", debug_view=" + mipraster::to_string(debug_view) +
            (estimate_error ? ", estimate_error" : "") + (block_skipping ? "" : ", no block skipping") +
-           (deferred_shading ? "" : ", no deferred shading") +
+           (deferred_shading ? "" : ", no deferred shading") + (batched_lookups ? "" : ", no batched lookups") +
            (tile_mask.empty() ? "" : ", tile_mask=" + std::to_string(tile_mask.size()) + " tiles") +
            (pixels.empty() ? "" : ", pixels=" + std::to_string(pixels.size())) + ")";
 }

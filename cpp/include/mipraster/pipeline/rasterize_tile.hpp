@@ -88,6 +88,10 @@ struct DrawInputs {
     /// cell of its pattern, 1/columns × 1/rows pixel (as if rendered at that finer resolution),
     /// so (1/columns, 1/rows); else (1, 1).
     glm::dvec2 footprint_scale{1.0};
+    /// Look textures up kLookupBatch samples at a time in float (BatchSampler: within
+    /// batch_sampling_tolerance of sample_texture); false: one sample_texture call per shade,
+    /// the reference. Debug views always take the reference path.
+    bool batched_lookups = true;
 };
 
 /// Triangles of one draw, in submission order: tris[indices[k]] for k < count.

@@ -65,6 +65,11 @@ struct RenderSettings {
     /// image is the same bit for bit, and so are the counters but shader_invocations; false
     /// always shades while rasterizing, for comparison.
     bool deferred_shading = true;
+    /// Textured draws look their texture up eight samples at a time in float vectors where the
+    /// sampler allows (BatchSampler: bilinear or trilinear, repeat or clamp), each value within
+    /// batch_sampling_tolerance of the double-precision reference sample_texture; false calls
+    /// the reference for every sample.
+    bool batched_lookups = true;
     /// Called as tiles finish with (tiles done, tiles in all); calls are serialized (never
     /// concurrent) but may come from any worker thread. Empty: no progress reports.
     std::function<void(std::size_t, std::size_t)> progress;
