@@ -526,6 +526,43 @@ TEST(BatchSampler, PowerOfTwoFootprintsReadTheirLevels) {
     }
 }
 
+// Beyond the stated bound: at an exact 2^k footprint on a power-of-two texture and uv in [0, 1)
+// (no wrapping: outside it, moving a coordinate by a period rounds in float), u·w, the bilinear
+// fractions and λ = k are exact in float and no two levels are blended, so a float path that
+// blends like sample_texture (a + t·(b − a), along u first) gives its bits.
+TEST(BatchSampler, ExactLevelFootprintGivesSampleTextureBits) {
+    for (const TextureCase tc : {TextureCase{64, 64, 1.0f}, TextureCase{256, 128, 100.0f}}) {
+        const mr::Texture tex = make_texture(tc, 5000 + tc.w);
+        mr::TextureView view(tex);
+        LookupGen gen(tc.w, tc.h, 5100 + tc.w);
+        for (auto fp : {mr::FootprintFilter::isotropic, mr::FootprintFilter::anisotropic})
+            for (auto wrap : {mr::WrapMode::repeat, mr::WrapMode::clamp}) {
+                mr::Sampler s;
+                s.footprint = fp;
+                s.wrap_u = s.wrap_v = wrap;
+                mr::BatchSampler batch_sampler(view, s);
+                for (int k = 0; k < view.level_count(); ++k) {
+                    const float t = std::ldexp(1.0f, k);
+                    const glm::vec2 dx(t / tc.w, 0.0f), dy(0.0f, t / tc.h);
+                    mr::LookupBatch batch;
+                    batch.count = mr::kLookupBatch;
+                    for (int lane = 0; lane < batch.count; ++lane)
+                        batch.set(lane, {float(gen.uniform(0.0, 1.0)), float(gen.uniform(0.0, 1.0))}, dx, dy);
+                    glm::vec4 out[mr::kLookupBatch];
+                    batch_sampler.sample(batch, out);
+                    for (int lane = 0; lane < batch.count; ++lane) {
+                        const glm::vec2 uv(batch.u[lane], batch.v[lane]);
+                        const glm::vec4 expected = mr::sample_texture(view, s, uv, dx, dy);
+                        EXPECT_TRUE(same_bits(out[lane], expected)) << tc.w << "x" << tc.h << " " << str(s) << " k "
+                                                                    << k << " uv " << str(uv) << ": batch "
+                                                                    << str(out[lane]) << ", sample_texture "
+                                                                    << str(expected);
+                    }
+                }
+            }
+    }
+}
+
 // DESIGN.md §3, levels no lookup needs are never built: a BatchSampler on a fresh texture doing
 // only magnifying lookups builds no level, and lookups at exactly λ = 1 build level 1 alone.
 TEST(BatchSampler, BuildsOnlyTheLevelsItsLookupsNeed) {
