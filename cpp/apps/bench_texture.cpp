@@ -20,6 +20,9 @@
 //    pass first (builds the mip levels / summed-area table), then R timed passes; lookups/s of the
 //    best pass (the anchor's statistic, best of 2) and of the median pass. This program does not
 //    pin itself: run it under `taskset -c 0` (the Python driver does).
+//  * trilinear_batch and anisotropic_batch: the trilinear and anisotropic samplers through
+//    BatchSampler (texture/sample_batch.hpp), kLookupBatch lookups per call, timed and measured
+//    like the others (same points, same pattern, same lookup count).
 //
 // Usage errors exit with status 2, failures with 1.
 #include <algorithm>
@@ -33,6 +36,7 @@
 #include <iterator>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -40,6 +44,7 @@
 #include <glm/vec4.hpp>
 
 #include "mipraster/texture/sample.hpp"
+#include "mipraster/texture/sample_batch.hpp"
 #include "mipraster/texture/sampler.hpp"
 #include "cli_options.hpp"
 #include "mipraster/texture/texture.hpp"
@@ -54,6 +59,8 @@ constexpr const char* kUsage =
     "Measures mipraster's texture filters (nearest, bilinear, trilinear, anisotropic, ewa, sat) like\n"
     "/work/shared/bench/anchor_oiio_texture.cpp: error against the exact box-filtered footprint\n"
     "average on a 1024^2 checker and zone plate, and single-thread lookups/s on the zone plate.\n"
+    "trilinear_batch and anisotropic_batch are trilinear and anisotropic through BatchSampler,\n"
+    "8 lookups per call (the same points, pattern and lookup count).\n"
     "Prints Markdown tables to stdout, progress to stderr, and writes the results to OUT.json.\n"
     "Run it pinned to one CPU (taskset -c 0 ...) for stable timings.\n"
     "\n"
@@ -62,8 +69,8 @@ constexpr const char* kUsage =
     "  --n-timing N        lookups per timed pass                        [1048576]\n"
     "  --n-acc M           accuracy footprints per texture and footprint [20000]\n"
     "  --reps R            timed passes after the warm-up pass, >= 1     [5]\n"
-    "  --filters LIST      comma-separated subset of\n"
-    "                      nearest,bilinear,trilinear,anisotropic,ewa,sat [all]\n"
+    "  --filters LIST      comma-separated subset of nearest,bilinear,trilinear,\n"
+    "                      trilinear_batch,anisotropic,anisotropic_batch,ewa,sat [all]\n"
     "  --footprints LIST   comma-separated subset of mag_0.25px,iso_8x8,\n"
     "                      aniso_8to1_45deg,aniso_8to1_axis (e.g. for profiling) [all]\n"
     "  --markdown PATH     also write the Markdown tables to PATH\n"
@@ -88,10 +95,29 @@ const Footprint kFootprints[] = {
 struct Filter {
     std::string name;
     Sampler sampler;
+    bool batched = false;  // through BatchSampler, kLookupBatch lookups per call
 };
 
+// The filters that have a "<name>_batch" variant: the samplers BatchSampler's float path takes.
+constexpr const char* kBatchSuffix = "_batch";
+const char* const kBatchedFilters[] = {"trilinear", "anisotropic"};
+
 Filter make_filter(const std::string& name) {
-    Filter f{name, Sampler::from_filter_name(name)};
+    std::string base = name;
+    const std::size_t suffix = std::strlen(kBatchSuffix);
+    const bool batched = name.size() > suffix && name.compare(name.size() - suffix, suffix, kBatchSuffix) == 0;
+    if (batched) {
+        base = name.substr(0, name.size() - suffix);
+        if (std::find(std::begin(kBatchedFilters), std::end(kBatchedFilters), base) == std::end(kBatchedFilters))
+            throw std::invalid_argument("filter: unknown name '" + name +
+                                        "'; the batched filters are trilinear_batch and anisotropic_batch");
+    }
+    Filter f{name, Sampler(), batched};
+    try {
+        f.sampler = Sampler::from_filter_name(base);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string(e.what()) + " (or a batched one: trilinear_batch, anisotropic_batch)");
+    }
     f.sampler.wrap_u = f.sampler.wrap_v = WrapMode::repeat;
     f.sampler.max_anisotropy = 16.0f;  // anisotropic: at most 16 probes; ewa: ratio cap 16
     f.sampler.validate();
@@ -190,6 +216,21 @@ Points coherent(const Footprint& f, size_t n) {
     return P;
 }
 
+// Lookups k < n at (s[k], t[k]) with one footprint through `sampler`, kLookupBatch per call (the
+// last call takes the rest); use(k, colour) for each.
+template <typename Use>
+inline void sample_batched(BatchSampler& sampler, const Points& P, glm::vec2 dx, glm::vec2 dy, Use&& use) {
+    LookupBatch batch;
+    glm::vec4 out[kLookupBatch];
+    const size_t n = P.s.size();
+    for (size_t k = 0; k < n; k += kLookupBatch) {
+        batch.count = static_cast<int>(std::min<size_t>(kLookupBatch, n - k));
+        for (int i = 0; i < batch.count; ++i) batch.set(i, glm::vec2(P.s[k + i], P.t[k + i]), dx, dy);
+        sampler.sample(batch, out);
+        for (int i = 0; i < batch.count; ++i) use(k + i, out[i]);
+    }
+}
+
 glm::vec2 deriv_x(const Footprint& f) { return {float(f.xs / kW), float(f.xt / kW)}; }
 glm::vec2 deriv_y(const Footprint& f) { return {float(f.ys / kW), float(f.yt / kW)}; }
 
@@ -260,7 +301,8 @@ int run(int argc, char** argv) {
     std::string out_json, out_md;
     long long n_timing = 1 << 20, n_acc = 20000, reps = 5;
     bool quick = false, set_timing = false, set_acc = false, set_reps = false;
-    std::vector<std::string> filter_names = {"nearest", "bilinear", "trilinear", "anisotropic", "ewa", "sat"};
+    std::vector<std::string> filter_names = {"nearest",           "bilinear", "trilinear", "trilinear_batch", "anisotropic",
+                                             "anisotropic_batch", "ewa",      "sat"};
     std::vector<std::string> footprint_names;
     for (const Footprint& f : kFootprints) footprint_names.push_back(f.name);
     for (int i = 1; i < argc; ++i) {
@@ -380,13 +422,19 @@ int run(int argc, char** argv) {
                 row.texture = tex_labels[ti];
                 row.footprint = f.name;
                 row.filter = filter.name;
-                for (size_t k = 0; k < gt.size(); ++k) {
-                    const glm::vec4 r = sample_texture(view, filter.sampler, glm::vec2(P.s[k], P.t[k]), dx, dy);
+                const auto add = [&](size_t k, const glm::vec4& r) {
                     const double d = double(r.x) - gt[k];
                     row.mae += std::fabs(d);
                     row.rmse += d * d;
                     row.bias += d;
                     row.maxe = std::max(row.maxe, std::fabs(d));
+                };
+                if (filter.batched) {
+                    BatchSampler batch(view, filter.sampler);
+                    sample_batched(batch, P, dx, dy, add);
+                } else {
+                    for (size_t k = 0; k < gt.size(); ++k)
+                        add(k, sample_texture(view, filter.sampler, glm::vec2(P.s[k], P.t[k]), dx, dy));
                 }
                 const double n = double(gt.size());
                 row.mae /= n;
@@ -412,11 +460,16 @@ int run(int argc, char** argv) {
                 TimingRow row;
                 row.footprint = f.name;
                 row.filter = filter.name;
+                BatchSampler batch(view, filter.sampler);  // one per draw, as a renderer would hold it
                 for (long long r = 0; r <= reps; ++r) {  // r == 0 is the warm-up pass
                     double acc = 0;
                     const auto t0 = Clock::now();
-                    for (size_t k = 0; k < C.s.size(); ++k)
-                        acc += sample_texture(view, filter.sampler, glm::vec2(C.s[k], C.t[k]), dx, dy).x;
+                    if (filter.batched) {
+                        sample_batched(batch, C, dx, dy, [&](size_t, const glm::vec4& r) { acc += r.x; });
+                    } else {
+                        for (size_t k = 0; k < C.s.size(); ++k)
+                            acc += sample_texture(view, filter.sampler, glm::vec2(C.s[k], C.t[k]), dx, dy).x;
+                    }
                     const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
                     if (r > 0) row.passes.push_back(double(n_timing) / dt);
                     checksum += acc;
@@ -451,8 +504,9 @@ int run(int argc, char** argv) {
 #endif
     std::fprintf(out, " \"samplers\": {");
     for (size_t i = 0; i < filters.size(); ++i)
-        std::fprintf(out, "%s\"%s\": \"%s\"", i ? ", " : "", filters[i].name.c_str(),
-                     json_escape(filters[i].sampler.to_string()).c_str());
+        std::fprintf(out, "%s\"%s\": \"%s%s\"", i ? ", " : "", filters[i].name.c_str(),
+                     json_escape(filters[i].sampler.to_string()).c_str(),
+                     filters[i].batched ? (" through BatchSampler, " + std::to_string(kLookupBatch) + " lookups per call").c_str() : "");
     std::fprintf(out, "},\n \"accuracy\": [\n");
     for (size_t i = 0; i < accuracy.size(); ++i) {
         const AccuracyRow& a = accuracy[i];
