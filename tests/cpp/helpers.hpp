@@ -24,6 +24,7 @@
 #include "mipraster/pipeline/sample_pattern.hpp"
 #include "mipraster/scene/camera.hpp"
 #include "mipraster/scene/mesh.hpp"
+#include "mipraster/texture/texture.hpp"
 #include "oracle.hpp"
 
 namespace helpers {
@@ -181,6 +182,26 @@ inline mr::Camera overlap_camera(mr::DepthConvention convention, int width, int 
     const double far = convention == mr::DepthConvention::opengl ? 20.0 : mr::kInfiniteFar;
     return mr::Camera::from_matrices(view, mr::perspective(1.0, double(width) / height, 0.05, far, convention),
                                      convention);
+}
+
+/// Large random triangles crossing each other at random depths (some cross the near plane, so
+/// clipped pieces take part), with uvs spanning several texture periods.
+inline mr::Mesh overlapping(std::size_t n, double size, std::uint64_t seed) {
+    mr::Mesh m = random_triangles(n, size, seed, {-1.5, -1.0, -2.0}, {3.0, 2.0, 8.0}, 0.5);
+    for (std::size_t i = 0; i < m.positions.size(); ++i)
+        m.uvs.push_back(glm::vec2(1.7f * m.positions[i].x + 0.3f * m.positions[i].z, 2.3f * m.positions[i].y));
+    return m;
+}
+
+/// An RGBA checker of 2×2-texel squares, n × m texels, values in [0.15, 0.9] (all channels vary).
+inline mr::Texture checker_texture(int n = 16, int m = 16) {
+    std::vector<float> texels;
+    for (int y = 0; y < m; ++y)
+        for (int x = 0; x < n; ++x) {
+            const float v = (x / 2 + y / 2) % 2 ? 0.9f : 0.15f;
+            texels.insert(texels.end(), {v, 0.5f * v + 0.2f * float(x) / n, 1.0f - v, 1.0f});
+        }
+    return mr::Texture::from_float(texels.data(), n, m, 4, true, "checker");
 }
 
 }  // namespace helpers

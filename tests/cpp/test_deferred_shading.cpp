@@ -17,26 +17,6 @@ namespace {
 namespace mr = mipraster;
 using namespace helpers;
 
-/// Large random triangles crossing each other at random depths (some cross the near plane, so
-/// clipped pieces take part), with uvs spanning several texture periods.
-mr::Mesh overlapping(std::size_t n, double size, std::uint64_t seed) {
-    mr::Mesh m = random_triangles(n, size, seed, {-1.5, -1.0, -2.0}, {3.0, 2.0, 8.0}, 0.5);
-    for (std::size_t i = 0; i < m.positions.size(); ++i)
-        m.uvs.push_back(glm::vec2(1.7f * m.positions[i].x + 0.3f * m.positions[i].z, 2.3f * m.positions[i].y));
-    return m;
-}
-
-mr::Texture checker_texture() {
-    const int n = 16;
-    std::vector<float> texels;
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-            const float v = (x / 2 + y / 2) % 2 ? 0.9f : 0.15f;
-            texels.insert(texels.end(), {v, 0.5f * v + 0.2f * float(x) / n, 1.0f - v, 1.0f});
-        }
-    return mr::Texture::from_float(texels.data(), n, n, 4, true, "deferred checker");
-}
-
 struct Outcome {
     mr::RenderResult forward, deferred;
 };
