@@ -40,15 +40,20 @@ struct UvSample {
 };
 
 /// The uvs of a set-up triangle's three vertices (mapped through the clip weights when it is a
-/// clipped piece) and the provoking vertex's uv for flat interpolation.
+/// clipped piece), the provoking vertex's uv for flat interpolation, and the screen weights'
+/// change per pixel step (for the derivatives; once per triangle rather than per sample).
 struct TriangleUvs {
     glm::dvec2 v[3];
     glm::dvec2 flat;
+    glm::dvec3 lx, ly;  // ∂λ_i/∂x = a_i·256/2A, ∂λ_i/∂y = b_i·256/2A
 
     TriangleUvs() = default;
     TriangleUvs(const SetupTriangle& t, const glm::uvec3& tri, const glm::vec2* uvs, const ClipWeights* clip_weights) {
         const glm::dvec2 o[3] = {glm::dvec2(uvs[tri[0]]), glm::dvec2(uvs[tri[1]]), glm::dvec2(uvs[tri[2]])};
         flat = o[0];
+        const double k = static_cast<double>(kSubpixelOne) * t.inv_area2;
+        lx = glm::dvec3(t.edge_a[0] * k, t.edge_a[1] * k, t.edge_a[2] * k);
+        ly = glm::dvec3(t.edge_b[0] * k, t.edge_b[1] * k, t.edge_b[2] * k);
         for (int i = 0; i < 3; ++i) {
             if (t.clip_index < 0) {
                 v[i] = o[i];
@@ -77,9 +82,8 @@ inline UvSample interpolate_uv(const SetupTriangle& t, const TriangleUvs& uvs, c
         s.uv = q.x * uvs.v[0] + q.y * uvs.v[1] + q.z * uvs.v[2];
         return s;
     }
-    const double k = static_cast<double>(kSubpixelOne) * t.inv_area2;
-    const glm::dvec3 lx(t.edge_a[0] * k, t.edge_a[1] * k, t.edge_a[2] * k);
-    const glm::dvec3 ly(t.edge_b[0] * k, t.edge_b[1] * k, t.edge_b[2] * k);
+    const glm::dvec3& lx = uvs.lx;
+    const glm::dvec3& ly = uvs.ly;
     if (mode == Interpolation::screen) {
         s.uv = l.x * uvs.v[0] + l.y * uvs.v[1] + l.z * uvs.v[2];
         s.dx = lx.x * uvs.v[0] + lx.y * uvs.v[1] + lx.z * uvs.v[2];
