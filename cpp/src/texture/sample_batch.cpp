@@ -40,6 +40,11 @@ inline To bits_as(From x) {
     std::memcpy(&r, &x, sizeof r);
     return r;
 }
+inline bool any(Ints mask) {
+    std::int64_t halves[2];
+    std::memcpy(halves, &mask, sizeof halves);
+    return (halves[0] | halves[1]) != 0;
+}
 inline Floats load_f(const float* p) {
     Floats r;
     std::memcpy(&r, p, sizeof r);
@@ -73,19 +78,20 @@ struct LanePlan {
     std::int32_t finite[kLookupBatch];  // 0: the lane is sample_texture's (−1: all inputs finite)
 };
 
+// A coordinate as every level reads it: repeat keeps its fraction (exact; from 2²³ on a float
+// holds none, and is kept away from the int conversion), clamp keeps it whole.
+[[gnu::always_inline]] inline Floats reduce(Floats coordinate, WrapMode mode) {
+    if (mode != WrapMode::repeat) return coordinate;
+    const Ints whole_number = (coordinate >= splat_f(0x1p23f)) | (coordinate <= splat_f(-0x1p23f));
+    const Floats bounded = whole_number ? splat_f(0.0f) : coordinate;
+    return bounded - to_float(floor_v(bounded));
+}
+
 // Texel indices and fractions along one axis at level sizes n (float and int, per lane), for a
-// bilinear quad at x = coordinate·n − ½; repeat or clamp.
-[[gnu::always_inline]] inline void axis(Floats coordinate, Floats n, Ints n_int, WrapMode mode, Ints& lo, Ints& hi, Floats& fraction) {
-    Floats x;
-    if (mode == WrapMode::repeat) {
-        // frac(coordinate) is exact (and so is its product with a power-of-two size); from 2²³ on
-        // a float holds no fraction, and is kept away from the int conversion.
-        const Ints whole_number = (coordinate >= splat_f(0x1p23f)) | (coordinate <= splat_f(-0x1p23f));
-        const Floats bounded = whole_number ? splat_f(0.0f) : coordinate;
-        x = (bounded - to_float(floor_v(bounded))) * n - 0.5f;
-    } else {
-        x = clamp_v(coordinate * n, splat_f(-2.0f), n + 2.0f) - 0.5f;
-    }
+// bilinear quad at x = coordinate·n − ½ (the product is exact for a power-of-two size).
+[[gnu::always_inline]] inline void axis(Floats reduced, Floats n, Ints n_int, WrapMode mode, Ints& lo, Ints& hi,
+                                        Floats& fraction) {
+    const Floats x = mode == WrapMode::repeat ? reduced * n - 0.5f : clamp_v(reduced * n, splat_f(-2.0f), n + 2.0f) - 0.5f;
     const Ints i = floor_v(x);
     fraction = x - to_float(i);
     if (mode == WrapMode::repeat) {
@@ -113,8 +119,8 @@ void plan_lanes(const LookupBatch& b, int first, const Sampler& s, int width_tex
     const Floats finite_check = (u - u) + (v - v) + px2 + py2;  // NaN or ∞ unless all finite
     const Ints finite = (finite_check < splat_f(kMax)) & (finite_check > splat_f(-kMax));
     // Those lanes' positions are not used: zero keeps every conversion below defined.
-    u = finite ? u : splat_f(0.0f);
-    v = finite ? v : splat_f(0.0f);
+    u = reduce(finite ? u : splat_f(0.0f), s.wrap_u);
+    v = reduce(finite ? v : splat_f(0.0f), s.wrap_v);
 
     Floats lambda = splat_f(0.0f);
     if (s.needs_derivatives() && s.mip_filter == MipFilter::linear) {
@@ -137,8 +143,10 @@ void plan_lanes(const LookupBatch& b, int first, const Sampler& s, int width_tex
     std::memcpy(plan.level + first, &fine, sizeof fine);
     std::memcpy(plan.level_weight + first, &weight, sizeof weight);
 
-    // Both levels' quads: level k and k + 1 (sizes max(1, ⌊w/2^k⌋), exact in float).
-    for (int step = 0; step < 2; ++step) {
+    // Both levels' quads: level k and k + 1 (sizes max(1, ⌊w/2^k⌋), exact in float); only level
+    // k where no lane blends (λ an integer: an exact 2^k footprint, or magnification).
+    const int steps = s.needs_derivatives() && s.mip_filter == MipFilter::linear && any(weight > 0.0f) ? 2 : 1;
+    for (int step = 0; step < steps; ++step) {
         const Ints k = min_v(fine + step, Ints{} + (levels - 1));
         const Ints scale_bits = (127 - k) << 23;
         const Floats scale = bits_as<Floats>(scale_bits);  // 2^−k
@@ -154,9 +162,34 @@ void plan_lanes(const LookupBatch& b, int first, const Sampler& s, int width_tex
         for (int c = 0; c < 4; ++c) std::memcpy(plan.texel[step][c] + first, &quad[c], sizeof quad[c]);
         std::memcpy(plan.fx[step] + first, &fx, sizeof fx);
         std::memcpy(plan.fy[step] + first, &fy, sizeof fy);
-        if (!s.needs_derivatives() || s.mip_filter != MipFilter::linear) break;  // level 0 only
     }
     std::memcpy(plan.finite + first, &finite, sizeof finite);
+}
+
+// Bits of the lanes whose anisotropic footprint takes more than one probe (those are
+// sample_texture's), decided in double as sample_texture decides it. Derivatives of equal
+// length (one probe) are found two lanes at a time; others ask anisotropic_probe_count.
+std::uint32_t several_probes(const LookupBatch& b, int n, int width, int height, float max_anisotropy) {
+    typedef double Doubles __attribute__((vector_size(16)));
+    typedef float Pair __attribute__((vector_size(8)));
+    std::uint32_t lanes = 0;
+    for (int l = 0; l < n; l += 2) {  // (an odd count reads one unused lane)
+        const auto widen = [&](const float* p) {
+            Pair x;
+            std::memcpy(&x, p + l, sizeof x);
+            return __builtin_convertvector(x, Doubles);
+        };
+        const Doubles ux = widen(b.dudx) * double(width), vx = widen(b.dvdx) * double(height);
+        const Doubles uy = widen(b.dudy) * double(width), vy = widen(b.dvdy) * double(height);
+        const Doubles px2 = ux * ux + vx * vx, py2 = uy * uy + vy * vy;
+        for (int k = l; k < l + 2 && k < n; ++k) {
+            const double x = px2[k - l], y = py2[k - l];
+            if (x == y && y > 0.0) continue;  // one probe
+            if (std::isfinite(x) && std::isfinite(y) && anisotropic_probe_count(x, y, max_anisotropy) > 1)
+                lanes |= 1u << k;
+        }
+    }
+    return lanes;
 }
 
 }  // namespace
@@ -188,16 +221,11 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     LanePlan plan;
     for (int first = 0; first < kLookupBatch; first += kWidth)
         plan_lanes(b, first, s, texture_.width(), texture_.height(), texture_.level_count(), plan);
+    const std::uint32_t several = s.footprint == FootprintFilter::anisotropic
+                                      ? several_probes(b, n, texture_.width(), texture_.height(), s.max_anisotropy)
+                                      : 0;
     for (int l = 0; l < n; ++l) {
-        bool reference = !plan.finite[l];
-        // An anisotropic footprint is one lookup only when it needs one probe (decided in double,
-        // as sample_texture decides it).
-        if (!reference && s.footprint == FootprintFilter::anisotropic) {
-            const double dux = double(b.dudx[l]) * texture_.width(), dvx = double(b.dvdx[l]) * texture_.height();
-            const double duy = double(b.dudy[l]) * texture_.width(), dvy = double(b.dvdy[l]) * texture_.height();
-            reference = anisotropic_probe_count(dux * dux + dvx * dvx, duy * duy + dvy * dvy, s.max_anisotropy) > 1;
-        }
-        if (reference) {
+        if (!plan.finite[l] || (several >> l & 1)) {
             out[l] = sample_texture(texture_, s, {b.u[l], b.v[l]}, {b.dudx[l], b.dvdx[l]}, {b.dudy[l], b.dvdy[l]});
             continue;
         }
