@@ -434,6 +434,47 @@ TEST(BatchSampler, ConstantTexturesAreReturnedExactly) {
     EXPECT_EQ(failures, 0);
 }
 
+// DESIGN.md §2.8 on the batch path: the four-lane (SSE2) and eight-lane (AVX2) float paths give the
+// same bits for every lookup kind, sampler and size. On a CPU without AVX2 the eight-lane path is
+// refused by name instead.
+TEST(BatchSampler, EveryVectorWidthGivesTheSameBits) {
+    EXPECT_THROW(mr::BatchSampler(mr::TextureView(make_texture(kTextures[0], 1)), mr::Sampler{}, 5), std::invalid_argument);
+    if (mr::BatchSampler::widest_vector() < 8) {
+        const mr::Texture tex = make_texture(kTextures[0], 1);
+        mr::TextureView view(tex);
+        EXPECT_THROW(mr::BatchSampler(view, mr::Sampler{}, 8), std::invalid_argument);
+        GTEST_SKIP() << "this CPU has no AVX2: only the four-lane path runs here";
+    }
+    long checked = 0;
+    for (std::size_t ti = 0; ti < std::size(kTextures); ++ti) {
+        const TextureCase& tc = kTextures[ti];
+        const mr::Texture tex = make_texture(tc, 4000 + ti);
+        mr::TextureView view(tex);
+        LookupGen gen(tc.w, tc.h, 4100 + ti);
+        for (int si = 0; si < 12; ++si) {
+            const mr::Sampler s = covered_sampler(gen);
+            mr::BatchSampler four(view, s, 4), eight(view, s, 8);
+            for (int bi = 0; bi < 120; ++bi) {
+                mr::LookupBatch batch;
+                batch.count = gen.integer(1, mr::kLookupBatch);
+                std::vector<Lookup> lookups;
+                for (int lane = 0; lane < batch.count; ++lane) {
+                    lookups.push_back(gen.next());
+                    put(batch, lane, lookups.back());
+                }
+                glm::vec4 a[mr::kLookupBatch], b[mr::kLookupBatch];
+                four.sample(batch, a);
+                eight.sample(batch, b);
+                for (int lane = 0; lane < batch.count; ++lane, ++checked)
+                    ASSERT_TRUE(same_bits(a[lane], b[lane]))
+                        << tc.w << "x" << tc.h << " " << str(s) << "\n  " << lookups[lane].describe() << "\n  four lanes "
+                        << str(a[lane]) << ", eight lanes " << str(b[lane]);
+            }
+        }
+    }
+    EXPECT_GE(checked, 20000);
+}
+
 // A lane's value does not depend on the batch around it: the same lookup alone in lane 0 and in any
 // lane of a batch of random other lookups (unused lanes holding garbage) gives the same bits, and
 // out[i] for i ≥ count is left untouched.

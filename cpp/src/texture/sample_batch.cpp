@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "mipraster/texture/sample.hpp"
 #include "texel.hpp"
@@ -13,59 +15,67 @@ namespace {
 
 using namespace texel;
 
-// Four lanes at a time in GCC/Clang vector types, one SSE2 register on the x86-64 baseline: the
-// same arithmetic on every CPU (DESIGN.md §2.8; -ffp-contract=off keeps multiply and add apart).
-// (Eight-lane types are split element by element by GCC on the baseline: far slower.)
-constexpr int kWidth = 4;
-typedef float Floats __attribute__((vector_size(16)));
-typedef std::int32_t Ints __attribute__((vector_size(16)));
+// Lanes in GCC/Clang vector types: four in one SSE2 register on the x86-64 baseline, eight in an
+// AVX2 register where the CPU has it. Element by element the same IEEE arithmetic either way
+// (no fused multiply-add: -ffp-contract=off, and AVX2 does not enable FMA), so the result does
+// not depend on the CPU (DESIGN.md §2.8). The helpers are always inlined into the one function
+// of each width, so the ABI note about 32-byte vectors on the baseline does not concern them.
+#pragma GCC diagnostic ignored "-Wpsabi"
+template <int W>
+struct Lanes {
+    typedef float Floats __attribute__((vector_size(4 * W)));
+    typedef std::int32_t Ints __attribute__((vector_size(4 * W)));
+};
+#define MIPRASTER_LANES(W)                       \
+    using Floats = typename Lanes<W>::Floats;    \
+    using Ints = typename Lanes<W>::Ints
 
-inline Floats splat_f(float x) { return Floats{} + x; }
-inline Floats min_v(Floats a, Floats b) { return a < b ? a : b; }
-inline Floats max_v(Floats a, Floats b) { return a > b ? a : b; }
-inline Floats clamp_v(Floats x, Floats lo, Floats hi) { return min_v(max_v(x, lo), hi); }
-inline Ints min_v(Ints a, Ints b) { return a < b ? a : b; }
-inline Ints max_v(Ints a, Ints b) { return a > b ? a : b; }
-inline Ints to_int(Floats x) { return __builtin_convertvector(x, Ints); }  // truncation
-inline Floats to_float(Ints x) { return __builtin_convertvector(x, Floats); }
-// ⌊x⌋ of |x| < 2³¹ (callers bound x first): truncate, then step down where that rounded up.
-inline Ints floor_v(Floats x) {
-    const Ints i = to_int(x);
-    return i + (to_float(i) > x);  // a true compare is −1
+template <typename V>
+[[gnu::always_inline]] inline V splat(float x) {
+    return V{} + x;
+}
+template <typename V>
+[[gnu::always_inline]] inline V min_v(V a, V b) {
+    return a < b ? a : b;
+}
+template <typename V>
+[[gnu::always_inline]] inline V max_v(V a, V b) {
+    return a > b ? a : b;
+}
+template <typename V>
+[[gnu::always_inline]] inline V clamp_v(V x, V lo, V hi) {
+    return min_v(max_v(x, lo), hi);
 }
 template <typename To, typename From>
-inline To bits_as(From x) {
+[[gnu::always_inline]] inline To convert(From x) {  // float → int truncates
+    return __builtin_convertvector(x, To);
+}
+// ⌊x⌋ of |x| < 2³¹ (callers bound x first): truncate, then step down where that rounded up.
+template <typename Ints, typename Floats>
+[[gnu::always_inline]] inline Ints floor_v(Floats x) {
+    const Ints i = convert<Ints>(x);
+    return i + (convert<Floats>(i) > x);  // a true compare is −1
+}
+template <typename To, typename From>
+[[gnu::always_inline]] inline To bits_as(From x) {
     static_assert(sizeof(To) == sizeof(From));
     To r;
     std::memcpy(&r, &x, sizeof r);
     return r;
 }
-inline bool any(Ints mask) {
-    std::int64_t halves[2];
-    std::memcpy(halves, &mask, sizeof halves);
-    return (halves[0] | halves[1]) != 0;
+template <typename Ints>
+[[gnu::always_inline]] inline bool any(Ints mask) {
+    std::int64_t words[sizeof(Ints) / 8];
+    std::memcpy(words, &mask, sizeof words);
+    std::int64_t all = 0;
+    for (std::int64_t w : words) all |= w;
+    return all != 0;
 }
-inline Floats load_f(const float* p) {
-    Floats r;
+template <typename V>
+[[gnu::always_inline]] inline V load_v(const float* p) {
+    V r;
     std::memcpy(&r, p, sizeof r);
     return r;
-}
-
-// log2 x of a positive normal x: the exponent plus log2 of the mantissa m ∈ [√½, √2) from the
-// series 2·atanh(s)/ln 2, s = (m − 1)/(m + 1), |s| ≤ 0.172, to s⁹ (the next term is < 4·10⁻¹⁰).
-// Exact at powers of two, so a 2^k footprint gives λ = k as the double path does.
-[[gnu::always_inline]] inline Floats log2_v(Floats x) {
-    const Ints bits = bits_as<Ints>(x);
-    Ints e = ((bits >> 23) & 0xff) - 127;
-    const Ints mantissa_bits = (bits & 0x7fffff) | 0x3f800000;
-    Floats m = bits_as<Floats>(mantissa_bits);
-    const Ints high = m > splat_f(1.41421356f);
-    m = high ? m * 0.5f : m;
-    e -= high;  // (−1 where true)
-    const Floats s = (m - 1.0f) / (m + 1.0f), s2 = s * s;
-    constexpr float k = 2.0f / 0.693147180559945309f;  // 2 / ln 2
-    const Floats series = s * (k + s2 * (k / 3 + s2 * (k / 5 + s2 * (k / 7 + s2 * (k / 9)))));
-    return to_float(e) + series;
 }
 
 // Per lane, what the blend needs: which level(s), the weight of the finer one's neighbour,
@@ -78,22 +88,46 @@ struct LanePlan {
     std::int32_t finite[kLookupBatch];  // 0: the lane is sample_texture's (−1: all inputs finite)
 };
 
+// log2 x of a positive normal x: the exponent plus log2 of the mantissa m ∈ [√½, √2) from the
+// series 2·atanh(s)/ln 2, s = (m − 1)/(m + 1), |s| ≤ 0.172, to s⁹ (the next term is < 4·10⁻¹⁰).
+// Exact at powers of two, so a 2^k footprint gives λ = k as the double path does.
+template <int W>
+[[gnu::always_inline]] inline typename Lanes<W>::Floats log2_v(typename Lanes<W>::Floats x) {
+    MIPRASTER_LANES(W);
+    const Ints bits = bits_as<Ints>(x);
+    Ints e = ((bits >> 23) & 0xff) - 127;
+    const Ints mantissa_bits = (bits & 0x7fffff) | 0x3f800000;
+    Floats m = bits_as<Floats>(mantissa_bits);
+    const Ints high = m > splat<Floats>(1.41421356f);
+    m = high ? m * 0.5f : m;
+    e -= high;  // (−1 where true)
+    const Floats s = (m - 1.0f) / (m + 1.0f), s2 = s * s;
+    constexpr float k = 2.0f / 0.693147180559945309f;  // 2 / ln 2
+    const Floats series = s * (k + s2 * (k / 3 + s2 * (k / 5 + s2 * (k / 7 + s2 * (k / 9)))));
+    return convert<Floats>(e) + series;
+}
+
 // A coordinate as every level reads it: repeat keeps its fraction (exact; from 2²³ on a float
 // holds none, and is kept away from the int conversion), clamp keeps it whole.
-[[gnu::always_inline]] inline Floats reduce(Floats coordinate, WrapMode mode) {
+template <int W>
+[[gnu::always_inline]] inline typename Lanes<W>::Floats reduce(typename Lanes<W>::Floats coordinate, WrapMode mode) {
+    MIPRASTER_LANES(W);
     if (mode != WrapMode::repeat) return coordinate;
-    const Ints whole_number = (coordinate >= splat_f(0x1p23f)) | (coordinate <= splat_f(-0x1p23f));
-    const Floats bounded = whole_number ? splat_f(0.0f) : coordinate;
-    return bounded - to_float(floor_v(bounded));
+    const Ints whole_number = (coordinate >= splat<Floats>(0x1p23f)) | (coordinate <= splat<Floats>(-0x1p23f));
+    const Floats bounded = whole_number ? splat<Floats>(0.0f) : coordinate;
+    return bounded - convert<Floats>(floor_v<Ints>(bounded));
 }
 
 // Texel indices and fractions along one axis at level sizes n (float and int, per lane), for a
 // bilinear quad at x = coordinate·n − ½ (the product is exact for a power-of-two size).
-[[gnu::always_inline]] inline void axis(Floats reduced, Floats n, Ints n_int, WrapMode mode, Ints& lo, Ints& hi,
-                                        Floats& fraction) {
-    const Floats x = mode == WrapMode::repeat ? reduced * n - 0.5f : clamp_v(reduced * n, splat_f(-2.0f), n + 2.0f) - 0.5f;
-    const Ints i = floor_v(x);
-    fraction = x - to_float(i);
+template <int W>
+[[gnu::always_inline]] inline void axis(typename Lanes<W>::Floats reduced, typename Lanes<W>::Floats n,
+                                        typename Lanes<W>::Ints n_int, WrapMode mode, typename Lanes<W>::Ints& lo,
+                                        typename Lanes<W>::Ints& hi, typename Lanes<W>::Floats& fraction) {
+    MIPRASTER_LANES(W);
+    const Floats x = mode == WrapMode::repeat ? reduced * n - 0.5f : clamp_v(reduced * n, splat<Floats>(-2.0f), n + 2.0f) - 0.5f;
+    const Ints i = floor_v<Ints>(x);
+    fraction = x - convert<Floats>(i);
     if (mode == WrapMode::repeat) {
         lo = i < 0 ? i + n_int : i;
         hi = i + 1 >= n_int ? i + 1 - n_int : i + 1;
@@ -104,42 +138,44 @@ struct LanePlan {
     }
 }
 
-// Lanes first … first + kWidth − 1 of the plan: whether they are finite, their level(s) and
-// the bilinear quads on them.
-void plan_lanes(const LookupBatch& b, int first, const Sampler& s, int width_texels, int height_texels, int levels,
-                LanePlan& plan) {
-    Floats u = load_f(first + b.u), v = load_f(first + b.v);
-    const Floats width = splat_f(static_cast<float>(width_texels)), height = splat_f(static_cast<float>(height_texels));
-    const Floats ux = load_f(first + b.dudx) * width, vx = load_f(first + b.dvdx) * height;
-    const Floats uy = load_f(first + b.dudy) * width, vy = load_f(first + b.dvdy) * height;
+// Lanes first … first + W − 1 of the plan: whether they are finite, their level(s) and the
+// bilinear quads on them.
+template <int W>
+[[gnu::always_inline]] inline void plan_lanes(const LookupBatch& b, int first, const Sampler& s, int width_texels,
+                                              int height_texels, int levels, LanePlan& plan) {
+    MIPRASTER_LANES(W);
+    Floats u = load_v<Floats>(first + b.u), v = load_v<Floats>(first + b.v);
+    const Floats width = splat<Floats>(static_cast<float>(width_texels)), height = splat<Floats>(static_cast<float>(height_texels));
+    const Floats ux = load_v<Floats>(first + b.dudx) * width, vx = load_v<Floats>(first + b.dvdx) * height;
+    const Floats uy = load_v<Floats>(first + b.dudy) * width, vy = load_v<Floats>(first + b.dvdy) * height;
     const Floats px2 = ux * ux + vx * vx, py2 = uy * uy + vy * vy;
     // Lanes for the reference: a non-finite uv, derivative or squared length (NaN fails every
     // compare; an overflow to ∞ fails < max).
     constexpr float kMax = std::numeric_limits<float>::max();
     const Floats finite_check = (u - u) + (v - v) + px2 + py2;  // NaN or ∞ unless all finite
-    const Ints finite = (finite_check < splat_f(kMax)) & (finite_check > splat_f(-kMax));
+    const Ints finite = (finite_check < splat<Floats>(kMax)) & (finite_check > splat<Floats>(-kMax));
     // Those lanes' positions are not used: zero keeps every conversion below defined.
-    u = reduce(finite ? u : splat_f(0.0f), s.wrap_u);
-    v = reduce(finite ? v : splat_f(0.0f), s.wrap_v);
+    u = reduce<W>(finite ? u : splat<Floats>(0.0f), s.wrap_u);
+    v = reduce<W>(finite ? v : splat<Floats>(0.0f), s.wrap_v);
 
-    Floats lambda = splat_f(0.0f);
+    Floats lambda = splat<Floats>(0.0f);
     if (s.needs_derivatives() && s.mip_filter == MipFilter::linear) {
         // λ as lod_from_log2_size computes it, in float: log2 ρ + bias, bounded, snapped to an
         // integer within 10⁻⁶, clamped to [min_lod, max_lod] and [0, levels − 1].
         const Floats rho2 = max_v(px2, py2);
         constexpr float kTiny = 0x1p-100f;  // below: log2 ρ = −∞ (what log2 0 gives in double)
-        Floats log2_rho = 0.5f * log2_v(max_v(rho2, splat_f(kTiny)));
-        log2_rho = rho2 < splat_f(kTiny) ? splat_f(-std::numeric_limits<float>::infinity()) : log2_rho;
-        lambda = clamp_v(log2_rho + s.lod_bias, splat_f(-1.0f), splat_f(static_cast<float>(levels)));
-        const Floats nearest_integer = to_float(floor_v(lambda + 0.5f));
+        Floats log2_rho = 0.5f * log2_v<W>(max_v(rho2, splat<Floats>(kTiny)));
+        log2_rho = rho2 < splat<Floats>(kTiny) ? splat<Floats>(-std::numeric_limits<float>::infinity()) : log2_rho;
+        lambda = clamp_v(log2_rho + s.lod_bias, splat<Floats>(-1.0f), splat<Floats>(static_cast<float>(levels)));
+        const Floats nearest_integer = convert<Floats>(floor_v<Ints>(lambda + 0.5f));
         const Floats distance = lambda - nearest_integer;
-        lambda = (distance < splat_f(1e-6f)) & (distance > splat_f(-1e-6f)) ? nearest_integer : lambda;
-        lambda = clamp_v(lambda, splat_f(s.min_lod), splat_f(s.max_lod));
-        lambda = clamp_v(lambda, splat_f(0.0f), splat_f(static_cast<float>(levels - 1)));
+        lambda = (distance < splat<Floats>(1e-6f)) & (distance > splat<Floats>(-1e-6f)) ? nearest_integer : lambda;
+        lambda = clamp_v(lambda, splat<Floats>(s.min_lod), splat<Floats>(s.max_lod));
+        lambda = clamp_v(lambda, splat<Floats>(0.0f), splat<Floats>(static_cast<float>(levels - 1)));
     }
-    const Ints fine = to_int(lambda);  // λ ∈ [0, levels − 1]: truncation is the floor
-    Floats weight = lambda - to_float(fine);
-    weight = fine + 1 < levels ? weight : splat_f(0.0f);
+    const Ints fine = convert<Ints>(lambda);  // λ ∈ [0, levels − 1]: truncation is the floor
+    Floats weight = lambda - convert<Floats>(fine);
+    weight = fine + 1 < levels ? weight : splat<Floats>(0.0f);
     std::memcpy(plan.level + first, &fine, sizeof fine);
     std::memcpy(plan.level_weight + first, &weight, sizeof weight);
 
@@ -150,13 +186,13 @@ void plan_lanes(const LookupBatch& b, int first, const Sampler& s, int width_tex
         const Ints k = min_v(fine + step, Ints{} + (levels - 1));
         const Ints scale_bits = (127 - k) << 23;
         const Floats scale = bits_as<Floats>(scale_bits);  // 2^−k
-        const Floats wk = max_v(to_float(to_int(width * scale)), splat_f(1.0f));
-        const Floats hk = max_v(to_float(to_int(height * scale)), splat_f(1.0f));
+        const Floats wk = max_v(convert<Floats>(convert<Ints>(width * scale)), splat<Floats>(1.0f));
+        const Floats hk = max_v(convert<Floats>(convert<Ints>(height * scale)), splat<Floats>(1.0f));
         Ints i0, i1, j0, j1;
         Floats fx, fy;
-        axis(u, wk, to_int(wk), s.wrap_u, i0, i1, fx);
-        axis(v, hk, to_int(hk), s.wrap_v, j0, j1, fy);
-        const Ints wk_int = to_int(wk);
+        axis<W>(u, wk, convert<Ints>(wk), s.wrap_u, i0, i1, fx);
+        axis<W>(v, hk, convert<Ints>(hk), s.wrap_v, j0, j1, fy);
+        const Ints wk_int = convert<Ints>(wk);
         const Ints row0 = j0 * wk_int, row1 = j1 * wk_int;
         const Ints quad[4] = {row0 + i0, row0 + i1, row1 + i0, row1 + i1};
         for (int c = 0; c < 4; ++c) std::memcpy(plan.texel[step][c] + first, &quad[c], sizeof quad[c]);
@@ -164,6 +200,15 @@ void plan_lanes(const LookupBatch& b, int first, const Sampler& s, int width_tex
         std::memcpy(plan.fy[step] + first, &fy, sizeof fy);
     }
     std::memcpy(plan.finite + first, &finite, sizeof finite);
+}
+
+// The plan of lanes 0 … count − 1: four at a time on the baseline, eight with AVX2.
+void plan_sse2(const LookupBatch& b, int count, const Sampler& s, int width, int height, int levels, LanePlan& plan) {
+    for (int first = 0; first < count; first += 4) plan_lanes<4>(b, first, s, width, height, levels, plan);
+}
+[[gnu::target("avx2")]] void plan_avx2(const LookupBatch& b, int, const Sampler& s, int width, int height, int levels,
+                                      LanePlan& plan) {
+    plan_lanes<8>(b, 0, s, width, height, levels, plan);
 }
 
 // Bits of the lanes whose anisotropic footprint takes more than one probe (those are
@@ -194,8 +239,19 @@ std::uint32_t several_probes(const LookupBatch& b, int n, int width, int height,
 
 }  // namespace
 
-BatchSampler::BatchSampler(const TextureView& texture, const Sampler& sampler)
-    : texture_(texture), sampler_(sampler), covered_(covers(sampler)) {}
+BatchSampler::BatchSampler(const TextureView& texture, const Sampler& sampler, int vector_width)
+    : texture_(texture), sampler_(sampler), covered_(covers(sampler)),
+      vector_width_(vector_width == 0 ? widest_vector() : vector_width) {
+    if (vector_width_ != 4 && vector_width_ != 8)
+        throw std::invalid_argument("BatchSampler: vector width " + std::to_string(vector_width) + "; expected 0, 4 or 8");
+    if (vector_width_ > widest_vector())
+        throw std::invalid_argument("BatchSampler: vector width 8 needs AVX2, which this CPU does not have");
+}
+
+int BatchSampler::widest_vector() {
+    static const int widest = __builtin_cpu_supports("avx2") ? 8 : 4;
+    return widest;
+}
 
 bool BatchSampler::covers(const Sampler& s) {
     const auto wrap = [](WrapMode m) { return m == WrapMode::repeat || m == WrapMode::clamp; };
@@ -218,14 +274,15 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     const LookupBatch& b = batch;
 
     const Sampler& s = sampler_;
-    LanePlan plan;
-    for (int first = 0; first < kLookupBatch; first += kWidth)
-        plan_lanes(b, first, s, texture_.width(), texture_.height(), texture_.level_count(), plan);
     const std::uint32_t several = s.footprint == FootprintFilter::anisotropic
                                       ? several_probes(b, n, texture_.width(), texture_.height(), s.max_anisotropy)
                                       : 0;
+    LanePlan plan;
+    if (several != (1u << n) - 1)  // (no plan when every lane takes several probes)
+        (vector_width_ == 8 ? plan_avx2 : plan_sse2)(b, n, s, texture_.width(), texture_.height(), texture_.level_count(),
+                                                     plan);
     for (int l = 0; l < n; ++l) {
-        if (!plan.finite[l] || (several >> l & 1)) {
+        if ((several >> l & 1) || !plan.finite[l]) {
             out[l] = sample_texture(texture_, s, {b.u[l], b.v[l]}, {b.dudx[l], b.dvdx[l]}, {b.dudy[l], b.dvdy[l]});
             continue;
         }

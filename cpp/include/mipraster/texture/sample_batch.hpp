@@ -40,11 +40,17 @@ inline double batch_sampling_tolerance(int width, int height) {
 /// covers()) go through it; every other lane (a non-finite uv or derivative, an anisotropic
 /// footprint that needs more than one probe, a sampler outside covers()) calls sample_texture,
 /// so its value is the reference's exactly. The result depends on neither the CPU nor the
-/// batch's other lanes (plain vector arithmetic, no fused multiply-add).
+/// batch's other lanes (element-wise vector arithmetic, no fused multiply-add).
 class BatchSampler {
 public:
     /// `texture` must outlive the sampler (the levels it reads are pinned by the view).
-    BatchSampler(const TextureView& texture, const Sampler& sampler);
+    /// `vector_width`: lanes per vector of the float path, 4 (SSE2), 8 (AVX2, where the CPU has
+    /// it) or 0 for widest_vector(); every width gives the same bits (std::invalid_argument for
+    /// another width, or 8 without AVX2).
+    BatchSampler(const TextureView& texture, const Sampler& sampler, int vector_width = 0);
+
+    /// 8 where the CPU has AVX2, else 4.
+    static int widest_vector();
 
     /// True when the sampler is one the float path takes: linear magnification and
     /// minification, mip filter none or linear, an isotropic or anisotropic footprint, repeat
@@ -58,6 +64,7 @@ private:
     const TextureView& texture_;
     Sampler sampler_;
     bool covered_;
+    int vector_width_;
     // Texels of the levels read so far (null: not asked for yet; asking may build it).
     const glm::vec4* level_texels_[32] = {};
     const glm::vec4* level(int k) { return level_texels_[k] ? level_texels_[k] : first_use(k); }
