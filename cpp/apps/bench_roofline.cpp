@@ -3,7 +3,8 @@
 //  * framebuffer-write bandwidth: streaming stores of an RGBA float colour buffer and a float depth
 //    buffer the size of a 1920×1080 frame (20 bytes a pixel, ~41 MB: larger than the caches), by 1
 //    and by 2 threads (each thread writes its own half of the rows);
-//  * trilinear throughput: mipraster's own sample_texture (trilinear, repeat) on a 1024² RGBA
+//  * trilinear throughput: mipraster's own lookups as renders make them (BatchSampler, eight at a
+//    time; trilinear, repeat) on a 1024² RGBA
 //    texture at a coherent pattern (a 1024-wide raster of pixels over a plane whose per-pixel uv
 //    derivatives are an isotropic footprint of d texels), lookups/s by 1 and 2 threads, for a few d
 //    (d ≤ 1 magnifies: one bilinear lookup; d > 1 blends two levels).
@@ -31,7 +32,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
-#include "mipraster/texture/sample.hpp"
+#include "mipraster/texture/sample_batch.hpp"
 #include "mipraster/texture/sampler.hpp"
 #include "cli_options.hpp"
 #include "mipraster/texture/texture.hpp"
@@ -45,7 +46,7 @@ constexpr const char* kUsage =
     "usage: mipraster_bench_roofline OUT.json [--quick] [--reps R] [--lookups N]\n"
     "\n"
     "Measures the framebuffer-write bandwidth (RGBA float + depth float over a 1920x1080 frame) and\n"
-    "mipraster's trilinear sample_texture throughput (1024^2 RGBA texture, coherent pattern), each\n"
+    "mipraster's trilinear lookup throughput (BatchSampler; 1024^2 RGBA texture, coherent pattern), each\n"
     "with 1 and 2 threads. Prints a summary to stdout and writes every pass to OUT.json.\n"
     "\n"
     "options:\n"
@@ -133,14 +134,23 @@ Texture make_texture() {
 
 // Lookups [lo, hi) of the coherent pattern: pixel k at (k mod 1024, k / 1024), uv advancing
 // d/1024 per pixel along x and y.
+// Through BatchSampler, eight at a time, as renders look textures up.
 glm::vec4 lookups(const TextureView& view, const Sampler& sampler, double d, std::size_t lo, std::size_t hi) {
     const float step = float(d / kTexSize);
     const glm::vec2 dx(step, 0.0f), dy(0.0f, step);
+    BatchSampler batch_sampler(view, sampler);
+    LookupBatch batch;
+    glm::vec4 out[kLookupBatch];
     glm::vec4 sum(0.0f);
-    for (std::size_t k = lo; k < hi; ++k) {
-        const double u = 0.5 + double(k % kPatternWidth) * d / kTexSize;
-        const double v = 0.5 + double(k / kPatternWidth) * d / kTexSize;
-        sum += sample_texture(view, sampler, glm::vec2(float(u - std::floor(u)), float(v - std::floor(v))), dx, dy);
+    for (std::size_t k = lo; k < hi; k += kLookupBatch) {
+        batch.count = static_cast<int>(std::min<std::size_t>(kLookupBatch, hi - k));
+        for (int l = 0; l < batch.count; ++l) {
+            const double u = 0.5 + double((k + l) % kPatternWidth) * d / kTexSize;
+            const double v = 0.5 + double((k + l) / kPatternWidth) * d / kTexSize;
+            batch.set(l, glm::vec2(float(u - std::floor(u)), float(v - std::floor(v))), dx, dy);
+        }
+        batch_sampler.sample(batch, out);
+        for (int l = 0; l < batch.count; ++l) sum += out[l];
     }
     return sum;
 }
@@ -228,7 +238,7 @@ int run(int argc, char** argv) {
             std::to_string(n) + ", \"unit\": \"lookups/s\", \"footprints\": [";
     const Texture texture = make_texture();
     const TextureView view(texture);
-    std::printf("trilinear sample_texture, 1024^2 RGBA, coherent pattern, %lld lookups a pass:\n", n);
+    std::printf("trilinear lookups (BatchSampler), 1024^2 RGBA, coherent pattern, %lld lookups a pass:\n", n);
     bool first = true;
     for (double d : kFootprints) {
         json += std::string(first ? "" : ",") + "\n  {\"texels_per_pixel\": " + std::to_string(d) + ", \"threads\": {";

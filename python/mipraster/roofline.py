@@ -2,7 +2,8 @@
 
 Two machine limits come from ``mipraster_bench_roofline`` (``cpp/apps/bench_roofline.cpp``): the
 framebuffer-write bandwidth (streaming RGBA float + depth float stores over a 1080p frame) and
-mipraster's trilinear ``sample_texture`` throughput at a coherent pattern, each for 1 and 2 threads.
+mipraster's trilinear lookup throughput (``BatchSampler``, as renders look textures up) at a
+coherent pattern, each for 1 and 2 threads.
 A frame's work is counted from its render statistics:
 
 * bytes written: every sample is cleared once and written again each time a fragment passes
