@@ -1,6 +1,7 @@
 #include "mipraster/pipeline/binning.hpp"
 
 #include "mipraster/core/constants.hpp"
+#include "mipraster/core/huge_pages.hpp"
 
 namespace mipraster {
 
@@ -18,6 +19,7 @@ void bin_triangles(BinnedChunk& chunk, const TileGrid& grid) {
     for (const SetupTriangle& t : chunk.triangles)
         for_each_tile(t, [&](int tile) { ++chunk.tile_start[static_cast<std::size_t>(tile) + 1]; });
     for (std::size_t i = 1; i < chunk.tile_start.size(); ++i) chunk.tile_start[i] += chunk.tile_start[i - 1];
+    reserve_on_huge_pages(chunk.tile_triangles, chunk.tile_start.back());
     chunk.tile_triangles.resize(chunk.tile_start.back());
     std::vector<std::uint32_t> cursor(chunk.tile_start.begin(), chunk.tile_start.end() - 1);
     for (std::uint32_t i = 0; i < chunk.triangles.size(); ++i)

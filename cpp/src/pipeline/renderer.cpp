@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "mipraster/core/constants.hpp"
+#include "mipraster/core/huge_pages.hpp"
 #include "mipraster/core/memory_limit.hpp"
 #include "mipraster/core/thread_pool.hpp"
 #include "mipraster/pipeline/binning.hpp"
@@ -122,7 +123,7 @@ void resolve_view_depth(const SampleWindow& depth, int x0, int y0, int x1, int y
 void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices,
                  const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid, BinnedChunk& chunk,
                  SetupCounters& counters, std::uint64_t& clipped) {
-    chunk.triangles.reserve(range.last - range.first);
+    reserve_on_huge_pages(chunk.triangles, range.last - range.first);
     SetupTriangle st;
     ClipPolygon polygon;
     for (std::uint32_t t = range.first; t < range.last; ++t) {
@@ -414,6 +415,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         ClipSpaceGeometry& g = geometry[d];
         g.triangles = &mesh.triangles;
         g.cull = draws[d].state.cull;
+        reserve_on_huge_pages(g.positions, mesh.positions.size());
         g.positions.resize(mesh.positions.size());
         g.outcodes.resize(mesh.positions.size());
         pool.parallel_for((mesh.positions.size() + kVertexBlock - 1) / kVertexBlock, [&](std::size_t b) {
