@@ -159,10 +159,12 @@ template <int W>
     v = reduce<W>(finite ? v : splat<Floats>(0.0f), s.wrap_v);
 
     Floats lambda = splat<Floats>(0.0f);
-    if (s.needs_derivatives() && s.mip_filter == MipFilter::linear) {
+    const Floats rho2 = max_v(px2, py2);
+    // λ = 0 for every lane when all plainly magnify (ρ ≤ 1 texel, no bias, no positive min_lod).
+    const bool magnifying = s.lod_bias == 0.0f && s.min_lod <= 0.0f && !any(rho2 > splat<Floats>(1.0f));
+    if (s.needs_derivatives() && s.mip_filter == MipFilter::linear && !magnifying) {
         // λ as lod_from_log2_size computes it, in float: log2 ρ + bias, bounded, snapped to an
         // integer within 10⁻⁶, clamped to [min_lod, max_lod] and [0, levels − 1].
-        const Floats rho2 = max_v(px2, py2);
         constexpr float kTiny = 0x1p-100f;  // below: log2 ρ = −∞ (what log2 0 gives in double)
         Floats log2_rho = 0.5f * log2_v<W>(max_v(rho2, splat<Floats>(kTiny)));
         log2_rho = rho2 < splat<Floats>(kTiny) ? splat<Floats>(-std::numeric_limits<float>::infinity()) : log2_rho;
