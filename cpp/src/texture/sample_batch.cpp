@@ -208,10 +208,16 @@ template <int W>
 void plan_sse2(const LookupBatch& b, int count, const Sampler& s, int width, int height, int levels, LanePlan& plan) {
     for (int first = 0; first < count; first += 4) plan_lanes<4>(b, first, s, width, height, levels, plan);
 }
+#if defined(__x86_64__)
 [[gnu::target("avx2")]] void plan_avx2(const LookupBatch& b, int, const Sampler& s, int width, int height, int levels,
                                       LanePlan& plan) {
     plan_lanes<8>(b, 0, s, width, height, levels, plan);
 }
+#else  // (other CPUs: the four-lane path; never called)
+void plan_avx2(const LookupBatch& b, int count, const Sampler& s, int width, int height, int levels, LanePlan& plan) {
+    plan_sse2(b, count, s, width, height, levels, plan);
+}
+#endif
 
 // Bits of the lanes whose anisotropic footprint takes more than one probe (those are
 // sample_texture's), decided in double as sample_texture decides it. Derivatives of equal
@@ -251,7 +257,11 @@ BatchSampler::BatchSampler(const TextureView& texture, const Sampler& sampler, i
 }
 
 int BatchSampler::widest_vector() {
+#if defined(__x86_64__)
     static const int widest = __builtin_cpu_supports("avx2") ? 8 : 4;
+#else
+    static const int widest = 4;
+#endif
     return widest;
 }
 
