@@ -439,6 +439,17 @@ TEST(BatchSampler, ConstantTexturesAreReturnedExactly) {
 // refused by name instead.
 TEST(BatchSampler, EveryVectorWidthGivesTheSameBits) {
     EXPECT_THROW(mr::BatchSampler(mr::TextureView(make_texture(kTextures[0], 1)), mr::Sampler{}, 5), std::invalid_argument);
+    {  // (and a batch count out of range is refused, not read past the arrays)
+        const mr::Texture tex = make_texture(kTextures[0], 1);
+        mr::TextureView view(tex);
+        mr::BatchSampler sampler(view, mr::Sampler{});
+        mr::LookupBatch batch;
+        glm::vec4 out[mr::kLookupBatch];
+        for (int bad : {-1, mr::kLookupBatch + 1}) {
+            batch.count = bad;
+            EXPECT_THROW(sampler.sample(batch, out), std::invalid_argument);
+        }
+    }
     if (mr::BatchSampler::widest_vector() < 8) {
         const mr::Texture tex = make_texture(kTextures[0], 1);
         mr::TextureView view(tex);

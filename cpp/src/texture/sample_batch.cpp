@@ -277,6 +277,9 @@ const glm::vec4* BatchSampler::first_use(int k) { return level_texels_[k] = text
 
 void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     const int n = batch.count;
+    if (n < 0 || n > kLookupBatch)
+        throw std::invalid_argument("BatchSampler: batch count " + std::to_string(n) + "; expected 0 to " +
+                                    std::to_string(kLookupBatch));
     if (!covered_) {
         for (int l = 0; l < n; ++l)
             out[l] = sample_texture(texture_, sampler_, {batch.u[l], batch.v[l]}, {batch.dudx[l], batch.dvdx[l]},

@@ -57,7 +57,7 @@ public:
     /// or clamp on both axes. False: every lane is a sample_texture call.
     static bool covers(const Sampler& sampler);
 
-    /// out[i] for i < batch.count.
+    /// out[i] for i < batch.count (std::invalid_argument for a count outside 0 … kLookupBatch).
     void sample(const LookupBatch& batch, glm::vec4* out);
 
 private:
