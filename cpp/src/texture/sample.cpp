@@ -4,8 +4,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
+#include "anisotropic_line.hpp"
 #include "texel.hpp"
 
 namespace mipraster {
@@ -219,6 +221,22 @@ const std::array<double, kMostProbes + 1> kLog2Count = [] {
     return table;
 }();
 
+}  // namespace
+
+bool anisotropic_magnifies(double pmax2, const Sampler& s, int levels, double* log2_pmax) {
+    if (plainly_magnifies(pmax2, s)) return true;
+    // Without bias or a positive min_lod, ρ² > 1 + 10⁻⁵ gives log2 ρ > 7·10⁻⁶, past the snap: λ > 0.
+    const bool plain = s.lod_bias == 0.0f && s.min_lod <= 0.0f && s.max_lod > 0.0f && levels > 1;
+    if (!log2_pmax && plain && pmax2 > 1.00001) return false;
+    const double log2_rho = log2_size(pmax2);
+    if (log2_pmax) *log2_pmax = log2_rho;
+    // Surely minifying (λ > 0 after snapping and clamping) without working λ out; else ask.
+    const bool minifies = log2_rho + s.lod_bias > kLodSnap && s.max_lod > 0.0f && levels > 1;
+    return !minifies && lod_from_log2_size(log2_rho, s, levels) <= 0.0;
+}
+
+namespace {
+
 AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const Sampler& s, int levels) {
     AnisoProbes p;
     const double px2 = f.length2_x(), py2 = f.length2_y();
@@ -228,15 +246,8 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
         return p;
     }
     const double pmax2 = std::max(px2, py2);
-    if (plainly_magnifies(pmax2, s)) {
-        p.magnifies = true;
-        return p;
-    }
-    // One log2 serves both λs: the isotropic one (log2 Pmax) and the probes' (log2 Pmax − log2 N).
-    const double log2_pmax = log2_size(pmax2);
-    // Surely minifying (λ > 0 after snapping and clamping) without working λ out; else ask.
-    const bool minifies = log2_pmax + s.lod_bias > kLodSnap && s.max_lod > 0.0f && levels > 1;
-    if (!minifies && lod_from_log2_size(log2_pmax, s, levels) <= 0.0) {
+    double log2_pmax = 0.0;
+    if (anisotropic_magnifies(pmax2, s, levels, &log2_pmax)) {  // (also finds log2 Pmax: one log2 for both λs)
         p.magnifies = true;
         return p;
     }
@@ -247,6 +258,33 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
     p.dv = major.y;
     return p;
 }
+
+// Texel indices and fractions of probes k0 … k0 + n − 1 (n ≤ 16) on a line inside a level: x = x0 +
+// k·step·sx ≥ 0 (likewise y), i = ⌊x⌋ by truncation. Two probes per SSE2 vector: element by element
+// the arithmetic of one probe at a time, so the bits are the same.
+struct ProbePositions {
+    std::int32_t i[16], j[16];
+    float fx[16], fy[16];
+
+    void fill(int k0, int n, double step, double x0, double sx, double y0, double sy) {
+        typedef double Doubles __attribute__((vector_size(16)));
+        typedef std::int32_t Ints __attribute__((vector_size(8)));
+        typedef float Floats __attribute__((vector_size(8)));
+        const auto axis = [&](Doubles t, double origin, double slope, std::int32_t* index, float* fraction, int c) {
+            const Doubles x = origin + t * slope;
+            const Ints whole = __builtin_convertvector(x, Ints);
+            const Floats f = __builtin_convertvector(x - __builtin_convertvector(whole, Doubles), Floats);
+            std::memcpy(index + c, &whole, sizeof whole);
+            std::memcpy(fraction + c, &f, sizeof f);
+        };
+        for (int c = 0; c < n; c += 2) {  // (an odd n also places probe k0 + n, one step past the end: unread)
+            const Doubles k = {double(k0 + c), double(k0 + c + 1)};
+            const Doubles t = k * step;
+            axis(t, x0, sx, i, fx, c);
+            axis(t, y0, sy, j, fy, c);
+        }
+    }
+};
 
 // The mean of the p.count probes on one level, u + ((i + ½)/N − ½)·(du, dv) for i < N. Kept as the
 // first probe plus the mean difference from it, so a constant texture gives back its value
@@ -270,16 +308,23 @@ template <TexelFilter kFilter>
         if (std::min(x0, x1) >= 0.0 && std::max(x0, x1) < last_x && std::min(y0, y1) >= 0.0 &&
             std::max(y0, y1) < last_y) {
             const std::size_t w = level.width;
-            const auto quad = [&](int k) {
-                const double x = x0 + k * step * sx, y = y0 + k * step * sy;
-                const int i = static_cast<int>(x), j = static_cast<int>(y);  // x, y ≥ 0: truncation is floor
-                const glm::vec4* q = &level.texels[j * w + i];
-                return lerp_quad(load(q[0]), load(q[1]), load(q[w]), load(q[w + 1]), static_cast<float>(x - i),
-                                 static_cast<float>(y - j));
+            const glm::vec4* texels = level.texels.data();
+            // Positions a chunk at a time, two probes per vector (the same double arithmetic as
+            // one at a time), then the blends in probe order.
+            constexpr int kChunk = 16;
+            ProbePositions at;
+            const auto quad = [&](int c) {
+                const glm::vec4* q = texels + static_cast<std::size_t>(at.j[c]) * w + at.i[c];
+                return lerp_quad(load(q[0]), load(q[1]), load(q[w]), load(q[w + 1]), at.fx[c], at.fy[c]);
             };
-            const Texel first = quad(0);
-            Texel difference = splat(0.0f);
-            for (int k = 1; k < p.count; ++k) difference += quad(k) - first;
+            Texel first = splat(0.0f), difference = splat(0.0f);
+            for (int k0 = 0; k0 < p.count; k0 += kChunk) {
+                const int n = std::min(kChunk, p.count - k0);
+                at.fill(k0, n, step, x0, sx, y0, sy);
+                int c = 0;
+                if (k0 == 0) first = quad(c++);
+                for (; c < n; ++c) difference += quad(c) - first;
+            }
             return first + difference * splat(static_cast<float>(step));
         }
     }
@@ -294,6 +339,18 @@ template <TexelFilter kFilter>
     for (int k = 1; k < p.count; ++k) difference += probe(k) - first;
     return first + difference * splat(static_cast<float>(step));
 }
+
+}  // namespace
+
+Texel anisotropic_line(const TextureLevel& level, const Sampler& s, double u, double v, double du, double dv, int count) {
+    AnisoProbes p;
+    p.count = count;
+    p.du = du;
+    p.dv = dv;
+    return probe_mean<TexelFilter::linear>(p, u, v, level, s);
+}
+
+namespace {
 
 Texel anisotropic(const TextureView& t, double u, double v, const Footprint& f, glm::vec2 dx, glm::vec2 dy,
                   const Sampler& s) {

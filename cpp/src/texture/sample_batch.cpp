@@ -1,5 +1,6 @@
 #include "mipraster/texture/sample_batch.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -7,6 +8,7 @@
 #include <string>
 
 #include "mipraster/texture/sample.hpp"
+#include "anisotropic_line.hpp"
 #include "texel.hpp"
 
 namespace mipraster {
@@ -141,8 +143,8 @@ template <int W>
 // Lanes first … first + W − 1 of the plan: whether they are finite, their level(s) and the
 // bilinear quads on them.
 template <int W>
-[[gnu::always_inline]] inline void plan_lanes(const LookupBatch& b, int first, const Sampler& s, int width_texels,
-                                              int height_texels, int levels, LanePlan& plan) {
+[[gnu::always_inline]] inline void plan_lanes(const LookupBatch& b, const float* rho2_scale, int first, const Sampler& s,
+                                              int width_texels, int height_texels, int levels, LanePlan& plan) {
     MIPRASTER_LANES(W);
     Floats u = load_v<Floats>(first + b.u), v = load_v<Floats>(first + b.v);
     const Floats width = splat<Floats>(static_cast<float>(width_texels)), height = splat<Floats>(static_cast<float>(height_texels));
@@ -159,7 +161,7 @@ template <int W>
     v = reduce<W>(finite ? v : splat<Floats>(0.0f), s.wrap_v);
 
     Floats lambda = splat<Floats>(0.0f);
-    const Floats rho2 = max_v(px2, py2);
+    const Floats rho2 = max_v(px2, py2) * load_v<Floats>(first + rho2_scale);
     // λ = 0 for every lane when all plainly magnify (ρ ≤ 1 texel, no bias, no positive min_lod).
     const bool magnifying = s.lod_bias == 0.0f && s.min_lod <= 0.0f && !any(rho2 > splat<Floats>(1.0f));
     if (s.needs_derivatives() && s.mip_filter == MipFilter::linear && !magnifying) {
@@ -205,27 +207,38 @@ template <int W>
 }
 
 // The plan of lanes 0 … count − 1: four at a time on the baseline, eight with AVX2.
-void plan_sse2(const LookupBatch& b, int count, const Sampler& s, int width, int height, int levels, LanePlan& plan) {
-    for (int first = 0; first < count; first += 4) plan_lanes<4>(b, first, s, width, height, levels, plan);
+void plan_sse2(const LookupBatch& b, const float* rho2_scale, int count, const Sampler& s, int width, int height,
+               int levels, LanePlan& plan) {
+    for (int first = 0; first < count; first += 4) plan_lanes<4>(b, rho2_scale, first, s, width, height, levels, plan);
 }
 #if defined(__x86_64__)
-[[gnu::target("avx2")]] void plan_avx2(const LookupBatch& b, int, const Sampler& s, int width, int height, int levels,
-                                      LanePlan& plan) {
-    plan_lanes<8>(b, 0, s, width, height, levels, plan);
+[[gnu::target("avx2")]] void plan_avx2(const LookupBatch& b, const float* rho2_scale, int, const Sampler& s, int width,
+                                      int height, int levels, LanePlan& plan) {
+    plan_lanes<8>(b, rho2_scale, 0, s, width, height, levels, plan);
 }
 #else  // (other CPUs: the four-lane path; never called)
-void plan_avx2(const LookupBatch& b, int count, const Sampler& s, int width, int height, int levels, LanePlan& plan) {
-    plan_sse2(b, count, s, width, height, levels, plan);
+void plan_avx2(const LookupBatch& b, const float* rho2_scale, int count, const Sampler& s, int width, int height,
+               int levels, LanePlan& plan) {
+    plan_sse2(b, rho2_scale, count, s, width, height, levels, plan);
 }
 #endif
 
-// Bits of the lanes whose anisotropic footprint takes more than one probe (those are
-// sample_texture's), decided in double as sample_texture decides it. Derivatives of equal
-// length (one probe) are found two lanes at a time; others ask anisotropic_probe_count.
-std::uint32_t several_probes(const LookupBatch& b, int n, int width, int height, float max_anisotropy) {
+// Per lane of an anisotropic batch, the line of probes sample_texture would take (decided in
+// double as it decides): how many probes, along which derivative, and the factor 1/N² that makes
+// the plan's λ log2(Pmax/N). One probe (count 1, factor 1) for isotropic footprints,
+// magnification and lanes that are not finite (the plan sends those to the reference).
+struct ProbeLines {
+    std::int32_t count[kLookupBatch];
+    bool along_x[kLookupBatch];
+    float rho2_scale[kLookupBatch];
+};
+
+// Fills `lines` for lanes 0 … n − 1 (rho2_scale arrives filled with 1); true when some lane
+// takes more than one probe.
+bool probe_lines(const LookupBatch& b, int n, int width, int height, int levels, const Sampler& s, ProbeLines& lines) {
     typedef double Doubles __attribute__((vector_size(16)));
     typedef float Pair __attribute__((vector_size(8)));
-    std::uint32_t lanes = 0;
+    bool some = false;
     for (int l = 0; l < n; l += 2) {  // (an odd count reads one unused lane)
         const auto widen = [&](const float* p) {
             Pair x;
@@ -237,12 +250,18 @@ std::uint32_t several_probes(const LookupBatch& b, int n, int width, int height,
         const Doubles px2 = ux * ux + vx * vx, py2 = uy * uy + vy * vy;
         for (int k = l; k < l + 2 && k < n; ++k) {
             const double x = px2[k - l], y = py2[k - l];
+            lines.count[k] = 1;
+            lines.along_x[k] = x >= y;
             if (x == y && y > 0.0) continue;  // one probe
-            if (std::isfinite(x) && std::isfinite(y) && anisotropic_probe_count(x, y, max_anisotropy) > 1)
-                lanes |= 1u << k;
+            if (!(std::isfinite(x) && std::isfinite(y))) continue;
+            const int count = anisotropic_probe_count(x, y, s.max_anisotropy);
+            if (count == 1 || anisotropic_magnifies(std::max(x, y), s, levels)) continue;
+            lines.count[k] = count;
+            lines.rho2_scale[k] = 1.0f / static_cast<float>(count * count);
+            some = true;
         }
     }
-    return lanes;
+    return some;
 }
 
 }  // namespace
@@ -289,16 +308,27 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     const LookupBatch& b = batch;
 
     const Sampler& s = sampler_;
-    const std::uint32_t several = s.footprint == FootprintFilter::anisotropic
-                                      ? several_probes(b, n, texture_.width(), texture_.height(), s.max_anisotropy)
-                                      : 0;
+    const int levels = texture_.level_count();
+    ProbeLines lines;
+    std::fill(lines.rho2_scale, lines.rho2_scale + kLookupBatch, 1.0f);
+    const bool some_lines = s.footprint == FootprintFilter::anisotropic &&
+                            probe_lines(b, n, texture_.width(), texture_.height(), levels, s, lines);
     LanePlan plan;
-    if (several != (1u << n) - 1)  // (no plan when every lane takes several probes)
-        (vector_width_ == 8 ? plan_avx2 : plan_sse2)(b, n, s, texture_.width(), texture_.height(), texture_.level_count(),
-                                                     plan);
+    (vector_width_ == 8 ? plan_avx2 : plan_sse2)(b, lines.rho2_scale, n, s, texture_.width(), texture_.height(), levels,
+                                                 plan);
     for (int l = 0; l < n; ++l) {
-        if ((several >> l & 1) || !plan.finite[l]) {
+        if (!plan.finite[l]) {
             out[l] = sample_texture(texture_, s, {b.u[l], b.v[l]}, {b.dudx[l], b.dvdx[l]}, {b.dudy[l], b.dvdy[l]});
+            continue;
+        }
+        if (some_lines && lines.count[l] > 1) {  // the reference's line of probes, on the plan's level(s)
+            const double du = lines.along_x[l] ? b.dudx[l] : b.dudy[l], dv = lines.along_x[l] ? b.dvdx[l] : b.dvdy[l];
+            const auto line = [&](int k) {
+                return anisotropic_line(texture_.level(k), s, b.u[l], b.v[l], du, dv, lines.count[l]);
+            };
+            Texel c = line(plan.level[l]);
+            if (plan.level_weight[l] > 0.0f) c = lerp(c, line(plan.level[l] + 1), plan.level_weight[l]);
+            out[l] = to_vec4(c);
             continue;
         }
         const auto quad = [&](int step) {

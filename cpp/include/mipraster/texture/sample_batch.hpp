@@ -1,8 +1,8 @@
 #pragma once
 // Texture lookups eight at a time: the footprint, λ and texel positions of all eight in float
-// vectors, then one trilinear blend per lookup. The fast path for the common samplers (bilinear
-// and trilinear, repeat or clamp); sample_texture (sample.hpp, double positions) stays the
-// reference it is tested against.
+// vectors, then one trilinear blend per lookup (or one line of anisotropic probes per level).
+// The fast path for the common samplers (bilinear, trilinear and anisotropic, repeat or clamp);
+// sample_texture (sample.hpp, double positions) stays the reference it is tested against.
 #include <cstdint>
 
 #include <glm/vec2.hpp>
@@ -37,10 +37,11 @@ inline double batch_sampling_tolerance(int width, int height) {
 }
 
 /// Samples one texture with one sampler a batch at a time. Lookups the float path handles (see
-/// covers()) go through it; every other lane (a non-finite uv or derivative, an anisotropic
-/// footprint that needs more than one probe, a sampler outside covers()) calls sample_texture,
-/// so its value is the reference's exactly. The result depends on neither the CPU nor the
-/// batch's other lanes (element-wise vector arithmetic, no fused multiply-add).
+/// covers()) go through it. An anisotropic footprint that needs several probes takes the
+/// reference's probe count and line of probes (in double), on the level(s) of the float λ.
+/// Every other lane (a non-finite uv or derivative, a sampler outside covers()) calls
+/// sample_texture, so its value is the reference's exactly. The result depends on neither the
+/// CPU nor the batch's other lanes (element-wise vector arithmetic, no fused multiply-add).
 class BatchSampler {
 public:
     /// `texture` must outlive the sampler (the levels it reads are pinned by the view).
