@@ -122,10 +122,11 @@ def render(data: bytes) -> bool:
         camera = mr.Camera.look_at(eye, target) if r.u8() % 2 else mr.Camera.orthographic(eye, target)
         result = mr.render(scene, camera, width, height, spp=spp, aa=aa, threads=1 + r.u8() % 2)
         assert result.color.shape == (height, width, 4)
-        # Shading multiplies texel by vertex colour: only where that product fits in a float is
-        # an infinite result the renderer's fault (1e28 × 1e28 overflows in any float pipeline).
+        # Shading multiplies texel by vertex colour, and the texture premultiplies each texel's
+        # colour by its alpha: only where colour × texel × alpha fits in a float is an infinite
+        # result the renderer's fault (1e28 × 1e28 overflows in any float pipeline).
         largest = lambda a: float(np.abs(a).max()) if a is not None and a.size else 1.0  # noqa: E731
-        if largest(colors) * max(largest(texels), 1.0) < 1e36:
+        if largest(colors) * max(largest(texels), 1.0) ** 2 < 1e36:
             assert np.isfinite(result.color).all(), "a render returned a non-finite colour"
     except EXPECTED:
         return False
