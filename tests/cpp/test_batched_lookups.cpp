@@ -3,7 +3,7 @@
 // render's colour within the batch tolerance (per shade: the untextured colour is at most 1 and the
 // texels at most 1), the same depth and the same counters, for every shading, sample mode, blend
 // mode, deferred or forward shading and thread count. Samplers it does not cover give the
-// reference's bits.
+// reference's bits, which also shows its vectorized interpolation gives the per-sample bits.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -154,6 +154,61 @@ TEST(BatchedLookups, UncoveredSamplersAndDebugViewsGiveTheReferenceBits) {
         s.debug_view = view;
         const Outcome o = render_both(draws, cam, s);
         EXPECT_TRUE(same_bits(o.batched.framebuffer.color, o.reference.framebuffer.color));
+    }
+}
+
+
+TEST(BatchedLookups, BatchedInterpolationGivesTheReferenceBits) {
+    // The queue interpolates a triangle's samples in vectors (interpolate_batch). Through samplers
+    // BatchSampler does not cover, the lookups are the reference's own, so any difference in the
+    // colour is the interpolation's: it must give the per-sample functions' bits for every
+    // shading (no vertex colours: constant; flat, screen, perspective), uv interpolation,
+    // derivative mode, sample mode, camera and forward or deferred shading, clipped pieces included.
+    const int W = 48, H = 40;
+    const mr::Mesh coloured = overlapping(90, 2.5, 81);
+    mr::Mesh plain = coloured;
+    plain.colors.clear();
+    mr::Sampler mirror, mirror_bilinear;  // λ and derivatives; uv only (no mip levels)
+    mirror.wrap_u = mirror_bilinear.wrap_u = mr::WrapMode::mirror;
+    mirror_bilinear.mip_filter = mr::MipFilter::none;
+    const auto convention = mr::DepthConvention::reverse_z;
+    const mr::Camera perspective = overlap_camera(convention, W, H);
+    const mr::Camera orthographic =
+        mr::Camera::from_matrices(mr::look_at({0.3, 0.8, 4.0}, {0, 0, 0}, {0, 1, 0}),
+                                  mr::orthographic(-2.0, 2.0, -1.5, 1.5, 0.05, 20.0, convention), convention);
+    const std::pair<int, mr::AntiAliasing> modes[] = {
+        {1, mr::AntiAliasing::ssaa}, {4, mr::AntiAliasing::ssaa}, {4, mr::AntiAliasing::msaa}};
+    for (const mr::Sampler& sampler : {mirror, mirror_bilinear}) {
+        ASSERT_FALSE(mr::BatchSampler::covers(sampler));
+        for (const mr::Mesh* mesh : {&coloured, static_cast<const mr::Mesh*>(&plain)})
+            for (mr::Interpolation interpolation :
+                 {mr::Interpolation::perspective, mr::Interpolation::screen, mr::Interpolation::flat})
+                for (const mr::Camera* cam : {&perspective, &orthographic})
+                    for (auto [samples, aa] : modes)
+                        for (mr::DerivativeMode derivatives : {mr::DerivativeMode::analytic, mr::DerivativeMode::quad})
+                            for (bool deferred : {false, true}) {
+                                SCOPED_TRACE(sampler.to_string() + (mesh == &plain ? ", no colours, " : ", ") +
+                                             mr::to_string(interpolation) +
+                                             (cam == &perspective ? ", perspective, " : ", orthographic, ") +
+                                             std::to_string(samples) + " " + mr::to_string(aa) + ", " +
+                                             mr::to_string(derivatives) + " derivatives" +
+                                             (deferred ? ", deferred" : ""));
+                                mr::DrawState state;
+                                state.interpolation = interpolation;
+                                std::vector<mr::Draw> draws = {
+                                    make_draw(*mesh, glm::dmat4(1.0), state, glm::vec4(0.9f, 0.7f, 1.0f, 0.8f))};
+                                draws[0].texture = checker_texture(20, 12);
+                                draws[0].sampler = sampler;
+                                auto s = settings(W, H, samples);
+                                s.anti_aliasing = aa;
+                                s.derivatives = derivatives;
+                                s.deferred_shading = deferred;
+                                const Outcome o = render_both(draws, *cam, s);
+                                expect_same_geometry(o);
+                                // (MSAA is never deferred)
+                                EXPECT_EQ(o.batched.stats.tiles_deferred > 0, deferred && aa != mr::AntiAliasing::msaa);
+                                EXPECT_TRUE(same_bits(o.batched.framebuffer.color, o.reference.framebuffer.color));
+                            }
     }
 }
 

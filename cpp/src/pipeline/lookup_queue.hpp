@@ -1,9 +1,10 @@
 #pragma once
-// Textured samples waiting for their texture lookup (private to the pipeline): each shade queues
-// its untextured colour and its lookup's inputs; every kLookupBatch of them go through one
-// BatchSampler call, then blend in the order they were queued, which is the order the forward
-// path blends them in. Blends read the target when they run, so a sample queued twice (by two
-// triangles) still sees the first result under the second.
+// Textured samples waiting for their shade (private to the pipeline): each shade queues its
+// sample's screen weights; every kLookupBatch of them are interpolated (interpolate_batch when
+// they all belong to one triangle it covers, else sample by sample), go through one BatchSampler
+// call, then blend in the order they were queued, which is the order the forward path blends
+// them in. Blends read the target when they run, so a sample queued twice (by two triangles)
+// still sees the first result under the second.
 #include <cstdint>
 
 #include <glm/vec4.hpp>
@@ -12,47 +13,94 @@
 #include "mipraster/pipeline/rasterize_tile.hpp"
 #include "mipraster/pipeline/shade_texture.hpp"
 #include "mipraster/texture/sample_batch.hpp"
+#include "interpolate_batch.hpp"
+#include "sample_shading.hpp"
 
 namespace mipraster {
 namespace kernels {
 
-template <BlendMode kBlend>
+template <BlendMode kBlend, Shading kShading, Texturing kTexturing>
 class LookupQueue {
 public:
-    explicit LookupQueue(const DrawInputs& draw) : sampler_(*draw.texture, *draw.sampler) {}
+    explicit LookupQueue(const DrawInputs& draw) : draw_(draw), sampler_(*draw.texture, *draw.sampler) {}
     LookupQueue(const LookupQueue&) = delete;
     LookupQueue& operator=(const LookupQueue&) = delete;
 
-    /// Queues the shade of samples `samples` (a bit mask) at 4-float colour slots of `target`: colour × the
-    /// texture at `lookup`.
-    void push(float* target, std::uint64_t samples, const glm::vec4& colour, const UvSample& lookup) {
-        lookups_.set(count_, glm::vec2(lookup.uv), glm::vec2(lookup.dx), glm::vec2(lookup.dy));
-        pending_[count_] = {target, samples, colour};
+    /// The triangle whose samples the next pushes are, with its vertex colours and uvs (copied:
+    /// the caller's change with the next triangle).
+    void begin_triangle(const SetupTriangle& t, const VertexValues& colors, const TriangleUvs& uvs,
+                        const ClipWeights* clip_weights) {
+        if (current_queued_) ++current_;  // keep the triangle of the samples already queued
+        current_queued_ = false;
+        triangles_[current_] = {&t, clip_weights, colors, uvs,
+                                interpolates_in_batches(draw_, kShading, kTexturing, t)};
+    }
+
+    /// Queues the shade of samples `samples` (a bit mask) at 4-float colour slots of `target`:
+    /// the current triangle at screen weights l of pixel (px, py).
+    void push(float* target, std::uint64_t samples, const glm::dvec3& l, int px, int py) {
+        weights_.l0[count_] = l.x, weights_.l1[count_] = l.y, weights_.l2[count_] = l.z;
+        pending_[count_] = {target, samples, current_, px, py};
+        current_queued_ = true;
         if (++count_ == kLookupBatch) flush();
     }
 
-    /// Looks up and blends what is queued (also before the kernel returns).
+    /// Shades and blends what is queued (also before the kernel returns).
     void flush() {
         if (count_ == 0) return;
-        lookups_.count = count_;
+        glm::vec4 colour[kLookupBatch];
+        const Triangle& first = triangles_[pending_[0].triangle];
+        if (first.batched && pending_[count_ - 1].triangle == pending_[0].triangle) {  // (triangles only advance)
+            weights_.count = count_;
+            interpolate_batch(draw_, kShading, kTexturing, *first.t, first.colors, first.uvs, weights_, colour,
+                              lookups_);
+        } else {
+            for (int i = 0; i < count_; ++i) {
+                const Pending& p = pending_[i];
+                const Triangle& tri = triangles_[p.triangle];
+                const glm::dvec3 l(weights_.l0[i], weights_.l1[i], weights_.l2[i]);
+                colour[i] = untextured_colour<kShading>(draw_, tri.colors, *tri.t, l, tri.clip_weights);
+                const UvSample s = texture_lookup<kTexturing>(draw_, *tri.t, tri.uvs, l, p.px, p.py);
+                lookups_.set(i, glm::vec2(s.uv), glm::vec2(s.dx), glm::vec2(s.dy));
+            }
+            lookups_.count = count_;
+        }
         glm::vec4 texture[kLookupBatch];
         sampler_.sample(lookups_, texture);
         for (int i = 0; i < count_; ++i) {
             const Pending& p = pending_[i];
-            glm::vec4 c = p.colour;
+            glm::vec4 c = colour[i];
             c *= texture[i];  // as shade() multiplies
             for (std::uint64_t m = p.samples; m; m &= m - 1) blend_into<kBlend>(p.target + 4 * __builtin_ctzll(m), c);
         }
         count_ = 0;
+        triangles_[0] = triangles_[current_];  // the current triangle stays, with nothing queued
+        current_ = 0;
+        current_queued_ = false;
     }
 
 private:
+    struct Triangle {
+        const SetupTriangle* t;
+        const ClipWeights* clip_weights;
+        VertexValues colors;
+        TriangleUvs uvs;
+        bool batched;  // interpolates_in_batches
+    };
     struct Pending {
         float* target;
         std::uint64_t samples;
-        glm::vec4 colour;
+        int triangle;  // index into triangles_
+        int px, py;
     };
+    const DrawInputs& draw_;
     BatchSampler sampler_;
+    // The triangles of the queued samples, in order, then the current one: at most one per
+    // queued sample plus one.
+    Triangle triangles_[kLookupBatch + 1];
+    int current_ = 0;
+    bool current_queued_ = false;  // some queued sample belongs to triangles_[current_]
+    BatchWeights weights_;
     LookupBatch lookups_;
     Pending pending_[kLookupBatch];
     int count_ = 0;

@@ -13,6 +13,7 @@
 #include "mipraster/pipeline/shade_texture.hpp"
 #include "mipraster/texture/sample.hpp"
 #include "lookup_queue.hpp"
+#include "sample_shading.hpp"
 #include "tile_blocks.hpp"
 
 namespace mipraster {
@@ -25,74 +26,15 @@ inline bool depth_passes(float z, float stored) {
     else return true;
 }
 
-// The texture lookup's inputs at screen weights l of pixel (px, py): uv and, for λ, its
-// derivatives (per pixel, or per sample cell under SSAA).
-template <Texturing kTexturing>
-inline UvSample texture_lookup(const DrawInputs& draw, const SetupTriangle& t, const TriangleUvs& uvs,
-                               const glm::dvec3& l, int px, int py) {
-    constexpr bool kLod = kTexturing == Texturing::lod;
-    UvSample s = interpolate_uv<kLod>(t, uvs, l, draw.uv_interpolation);
-    if constexpr (kLod) {
-        if (draw.derivatives == DerivativeMode::quad) quad_derivatives(t, uvs, draw.uv_interpolation, px, py, s);
-        if (draw.footprint_scale != glm::dvec2(1.0)) {  // SSAA: the sample's own cell, not the pixel
-            s.dx *= draw.footprint_scale.x;
-            s.dy *= draw.footprint_scale.y;
-        }
-    }
-    return s;
-}
-
-// The texture's contribution at screen weights l of pixel (px, py), one reference lookup.
-template <Texturing kTexturing>
-inline glm::vec4 texture_colour(const DrawInputs& draw, const SetupTriangle& t, const TriangleUvs& uvs,
-                                const glm::dvec3& l, int px, int py) {
-    const UvSample s = texture_lookup<kTexturing>(draw, t, uvs, l, px, py);
-    if constexpr (kTexturing == Texturing::lod) {
-        if (draw.debug_view == DebugView::uv)
-            return glm::vec4(static_cast<float>(s.uv.x - std::floor(s.uv.x)), static_cast<float>(s.uv.y - std::floor(s.uv.y)),
-                             0.0f, 1.0f);
-        if (draw.debug_view == DebugView::mip_level)
-            return mip_level_colour(texture_lod(*draw.texture, *draw.sampler, glm::vec2(s.dx), glm::vec2(s.dy)));
-    }
-    return sample_texture(*draw.texture, *draw.sampler, glm::vec2(s.uv), glm::vec2(s.dx), glm::vec2(s.dy));
-}
-
-// The colour before texturing: the draw colour × the vertex colours.
-template <Shading kShading>
-inline glm::vec4 untextured_colour(const DrawInputs& draw, const VertexValues& colors, const SetupTriangle& t,
-                                   const glm::dvec3& screen, const ClipWeights* clip_weights) {
-    if constexpr (kShading == Shading::constant) {
-        return draw.color;
-    } else if constexpr (kShading == Shading::flat) {
-        return draw.color * colors.v[0];
-    } else {
-        const glm::dvec3 w = kShading == Shading::perspective ? perspective_weights(t, screen) : screen;
-        return draw.color * colors.interpolate(original_weights(t, w, clip_weights));
-    }
-}
-
-template <Shading kShading, Texturing kTexturing>
-inline glm::vec4 shade(const DrawInputs& draw, const VertexValues& colors, const TriangleUvs& uvs,
-                       const SetupTriangle& t, const glm::dvec3& screen, const ClipWeights* clip_weights, int px,
-                       int py) {
-    if constexpr (kTexturing == Texturing::lod) {  // a debug view shows its colour unmodulated
-        if (draw.debug_view != DebugView::none) return texture_colour<kTexturing>(draw, t, uvs, screen, px, py);
-    }
-    glm::vec4 c = untextured_colour<kShading>(draw, colors, t, screen, clip_weights);
-    if constexpr (kTexturing != Texturing::none) c *= texture_colour<kTexturing>(draw, t, uvs, screen, px, py);
-    return c;
-}
-
 // Shades samples `samples` of one pixel (colour slots at `target`) with one colour: through the
 // lookup queue when there is one (textured draws), else at once.
 template <BlendMode kBlend, Shading kShading, Texturing kTexturing>
-inline void shade_into(LookupQueue<kBlend>* queue, float* target, std::uint64_t samples, const DrawInputs& draw,
-                       const VertexValues& colors, const TriangleUvs& uvs, const SetupTriangle& t,
+inline void shade_into(LookupQueue<kBlend, kShading, kTexturing>* queue, float* target, std::uint64_t samples,
+                       const DrawInputs& draw, const VertexValues& colors, const TriangleUvs& uvs, const SetupTriangle& t,
                        const glm::dvec3& screen, const ClipWeights* clip_weights, int px, int py) {
     if constexpr (kTexturing != Texturing::none) {
         if (queue) {
-            queue->push(target, samples, untextured_colour<kShading>(draw, colors, t, screen, clip_weights),
-                        texture_lookup<kTexturing>(draw, t, uvs, screen, px, py));
+            queue->push(target, samples, screen, px, py);
             return;
         }
     }
@@ -115,7 +57,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     const int S = kMode == SampleMode::single ? 1 : pattern.count();
     constexpr std::int64_t kStep = kSubpixelOne;  // one pixel in fixed point
     TileBlocks blocks(target, S);
-    std::optional<LookupQueue<kBlend>> queue;
+    std::optional<LookupQueue<kBlend, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
 
     for (std::size_t k = 0; k < batch.count; ++k) {
@@ -134,13 +76,16 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         const std::uint32_t classified = cls.skipped | cls.hidden;
 
         // The vertex colours of the original triangle, once per triangle and tile.
-        VertexValues colors;
+        VertexValues colors{};  // (constant shading: unused, zeros)
         if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective) {
             const glm::uvec3 tri = draw.triangles[t.triangle];
             colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
         }
         TriangleUvs uvs;
-        if constexpr (kTexturing != Texturing::none) uvs = TriangleUvs(t, draw.triangles[t.triangle], draw.uvs, batch.clip_weights);
+        if constexpr (kTexturing != Texturing::none) {
+            uvs = TriangleUvs(t, draw.triangles[t.triangle], draw.uvs, batch.clip_weights);
+            if (queue) queue->begin_triangle(t, colors, uvs, batch.clip_weights);
+        }
         // Deferred shading's pre-pass: the samples this triangle wins name it by this index.
         std::int32_t owner = -1;
         if constexpr (kShading == Shading::visibility) {
@@ -290,7 +235,7 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
     OwnerRef ref{};
     VertexValues colors{};
     TriangleUvs uvs{};
-    std::optional<LookupQueue<BlendMode::replace>> queue;
+    std::optional<LookupQueue<BlendMode::replace, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
     for (int py = target.y0; py < target.y1; ++py)
         for (int px = target.x0; px < target.x1; ++px) {
@@ -306,7 +251,10 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
                     const glm::uvec3 tri = draw.triangles[ref.triangle->triangle];
                     if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective)
                         colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
-                    if constexpr (kTexturing != Texturing::none) uvs = TriangleUvs(*ref.triangle, tri, draw.uvs, ref.clip_weights);
+                    if constexpr (kTexturing != Texturing::none) {
+                        uvs = TriangleUvs(*ref.triangle, tri, draw.uvs, ref.clip_weights);
+                        if (queue) queue->begin_triangle(*ref.triangle, colors, uvs, ref.clip_weights);
+                    }
                 }
                 const SetupTriangle& t = *ref.triangle;
                 const std::int64_t X = std::int64_t{px} * kSubpixelOne + pattern.x[s];

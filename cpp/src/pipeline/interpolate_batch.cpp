@@ -1,0 +1,149 @@
+#include "interpolate_batch.hpp"
+
+#include <cstring>
+
+namespace mipraster {
+namespace kernels {
+
+namespace {
+
+// Four doubles per vector: two SSE2 registers on the x86-64 baseline, one AVX2 register where the
+// CPU has it; the same IEEE operations element by element either way (-ffp-contract=off: no
+// fused multiply-add). Always inlined into the one function of each target.
+#pragma GCC diagnostic ignored "-Wpsabi"
+typedef double Doubles __attribute__((vector_size(32)));
+typedef float Floats __attribute__((vector_size(16)));
+constexpr int kWidth = 4;
+
+[[gnu::always_inline]] inline Doubles splat(double x) { return Doubles{x, x, x, x}; }  // (not 0 + x: keeps −0)
+[[gnu::always_inline]] inline Doubles load(const double* p) {
+    Doubles r;
+    std::memcpy(&r, p, sizeof r);
+    return r;
+}
+[[gnu::always_inline]] inline void store(float* p, Doubles x) {
+    const Floats f = __builtin_convertvector(x, Floats);
+    std::memcpy(p, &f, sizeof f);
+}
+// std::clamp(x, lo, hi) element by element: x < lo ? lo : hi < x ? hi : x.
+[[gnu::always_inline]] inline Floats clamp(Floats x, float lo, float hi) {
+    const Floats l = Floats{lo, lo, lo, lo}, h = Floats{hi, hi, hi, hi};
+    return x < l ? l : (h < x ? h : x);
+}
+
+// Samples first … first + 3.
+[[gnu::always_inline]] inline void interpolate_group(const DrawInputs& draw, Shading shading, Texturing texturing,
+                                                     const SetupTriangle& t, const VertexValues& colors,
+                                                     const TriangleUvs& uvs, const BatchWeights& w, int first,
+                                                     float (&channels)[4][kLookupBatch], LookupBatch& lookups) {
+    const Doubles l0 = load(w.l0 + first), l1 = load(w.l1 + first), l2 = load(w.l2 + first);
+    const bool perspective_uv = texturing != Texturing::none && draw.uv_interpolation == Interpolation::perspective;
+    // perspective_weights and interpolate_uv: q_i = λ_i / w_i and 1 / Σ q_i.
+    Doubles q0{}, q1{}, q2{}, inv_sum{};
+    if (shading == Shading::perspective || perspective_uv) {
+        q0 = l0 * double(t.inv_w[0]);
+        q1 = l1 * double(t.inv_w[1]);
+        q2 = l2 * double(t.inv_w[2]);
+        inv_sum = splat(1.0) / (q0 + q1 + q2);
+    }
+    if (shading == Shading::screen || shading == Shading::perspective) {  // VertexValues::interpolate
+        const bool screen = shading == Shading::screen;
+        const Doubles w0 = screen ? l0 : q0 * inv_sum, w1 = screen ? l1 : q1 * inv_sum, w2 = screen ? l2 : q2 * inv_sum;
+        for (int c = 0; c < 4; ++c) {
+            const Doubles sum = w0 * double(colors.v[0][c]) + w1 * double(colors.v[1][c]) + w2 * double(colors.v[2][c]);
+            const float k = draw.color[c];
+            const Floats clamped = clamp(__builtin_convertvector(sum, Floats), colors.lo[c], colors.hi[c]);
+            const Floats value = Floats{k, k, k, k} * clamped;
+            std::memcpy(channels[c] + first, &value, sizeof value);
+        }
+    }
+
+    // interpolate_uv (and texture_lookup's footprint scale).
+    const glm::dvec2 *v = uvs.v;
+    Doubles u, uv_v, dudx = splat(0.0), dvdx = splat(0.0), dudy = splat(0.0), dvdy = splat(0.0);
+    if (draw.uv_interpolation == Interpolation::flat) {
+        u = splat(uvs.flat.x);
+        uv_v = splat(uvs.flat.y);
+    } else if (texturing == Texturing::fixed) {  // uv only, from the normalized weights
+        const bool screen = !perspective_uv;
+        const Doubles w0 = screen ? l0 : q0 * inv_sum, w1 = screen ? l1 : q1 * inv_sum, w2 = screen ? l2 : q2 * inv_sum;
+        u = w0 * v[0].x + w1 * v[1].x + w2 * v[2].x;
+        uv_v = w0 * v[0].y + w1 * v[1].y + w2 * v[2].y;
+    } else if (!perspective_uv) {  // screen space: derivatives constant over the triangle
+        u = l0 * v[0].x + l1 * v[1].x + l2 * v[2].x;
+        uv_v = l0 * v[0].y + l1 * v[1].y + l2 * v[2].y;
+        const glm::dvec2 dx = uvs.lx.x * v[0] + uvs.lx.y * v[1] + uvs.lx.z * v[2];
+        const glm::dvec2 dy = uvs.ly.x * v[0] + uvs.ly.y * v[1] + uvs.ly.z * v[2];
+        dudx = splat(dx.x), dvdx = splat(dx.y), dudy = splat(dy.x), dvdy = splat(dy.y);
+    } else {  // perspective-correct, derivatives by the quotient rule
+        u = (q0 * v[0].x + q1 * v[1].x + q2 * v[2].x) * inv_sum;
+        uv_v = (q0 * v[0].y + q1 * v[1].y + q2 * v[2].y) * inv_sum;
+        for (int i = 0; i < 3; ++i) {
+            const Doubles scale = double(t.inv_w[i]) * inv_sum;
+            const Doubles rel_u = (v[i].x - u) * scale, rel_v = (v[i].y - uv_v) * scale;
+            dudx += uvs.lx[i] * rel_u;
+            dvdx += uvs.lx[i] * rel_v;
+            dudy += uvs.ly[i] * rel_u;
+            dvdy += uvs.ly[i] * rel_v;
+        }
+    }
+    if (texturing == Texturing::lod && draw.footprint_scale != glm::dvec2(1.0)) {
+        dudx *= draw.footprint_scale.x;
+        dvdx *= draw.footprint_scale.x;
+        dudy *= draw.footprint_scale.y;
+        dvdy *= draw.footprint_scale.y;
+    }
+    store(lookups.u + first, u);
+    store(lookups.v + first, uv_v);
+    store(lookups.dudx + first, dudx);
+    store(lookups.dvdx + first, dvdx);
+    store(lookups.dudy + first, dudy);
+    store(lookups.dvdy + first, dvdy);
+}
+
+[[gnu::always_inline]] inline void interpolate_all(const DrawInputs& draw, Shading shading, Texturing texturing,
+                                                   const SetupTriangle& t, const VertexValues& colors,
+                                                   const TriangleUvs& uvs, const BatchWeights& w, glm::vec4* colour,
+                                                   LookupBatch& lookups) {
+    float channels[4][kLookupBatch];
+    for (int first = 0; first < w.count; first += kWidth)
+        interpolate_group(draw, shading, texturing, t, colors, uvs, w, first, channels, lookups);
+    lookups.count = w.count;
+    for (int i = 0; i < w.count; ++i) {
+        if (shading == Shading::constant) colour[i] = draw.color;
+        else if (shading == Shading::flat) colour[i] = draw.color * colors.v[0];
+        else colour[i] = glm::vec4(channels[0][i], channels[1][i], channels[2][i], channels[3][i]);
+    }
+}
+
+void interpolate_baseline(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t,
+                          const VertexValues& colors, const TriangleUvs& uvs, const BatchWeights& w, glm::vec4* colour,
+                          LookupBatch& lookups) {
+    interpolate_all(draw, shading, texturing, t, colors, uvs, w, colour, lookups);
+}
+#if defined(__x86_64__)
+[[gnu::target("avx2")]] void interpolate_avx2(const DrawInputs& draw, Shading shading, Texturing texturing,
+                                              const SetupTriangle& t, const VertexValues& colors, const TriangleUvs& uvs,
+                                              const BatchWeights& w, glm::vec4* colour, LookupBatch& lookups) {
+    interpolate_all(draw, shading, texturing, t, colors, uvs, w, colour, lookups);
+}
+#else
+const auto interpolate_avx2 = interpolate_baseline;  // (never chosen: widest_vector() is 4)
+#endif
+
+}  // namespace
+
+bool interpolates_in_batches(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t) {
+    return shading != Shading::visibility && texturing != Texturing::none && t.clip_index < 0 &&
+           !(texturing == Texturing::lod && draw.derivatives == DerivativeMode::quad);
+}
+
+void interpolate_batch(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t,
+                       const VertexValues& colors, const TriangleUvs& uvs, const BatchWeights& w, glm::vec4* colour,
+                       LookupBatch& lookups) {
+    (BatchSampler::widest_vector() == 8 ? interpolate_avx2 : interpolate_baseline)(draw, shading, texturing, t, colors,
+                                                                                 uvs, w, colour, lookups);
+}
+
+}  // namespace kernels
+}  // namespace mipraster

@@ -1,0 +1,38 @@
+#pragma once
+// Interpolation for up to kLookupBatch textured samples of one triangle at once (private to the
+// pipeline): the untextured colour and the texture lookup's inputs (uv and its analytic
+// derivatives), in double vectors, four samples per vector. Element by element it is the
+// arithmetic of untextured_colour and texture_lookup (sample_shading.hpp), in the same order, with
+// no fused multiply-add, so each sample gets the same bits as from those scalar functions.
+#include <cstdint>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "mipraster/pipeline/interpolate.hpp"
+#include "mipraster/pipeline/rasterize_tile.hpp"
+#include "mipraster/pipeline/shade_texture.hpp"
+#include "mipraster/texture/sample_batch.hpp"
+
+namespace mipraster {
+namespace kernels {
+
+/// Screen weights of the samples, one array per vertex.
+struct BatchWeights {
+    double l0[kLookupBatch], l1[kLookupBatch], l2[kLookupBatch];
+    int count = 0;
+};
+
+/// True when interpolate_batch gives a triangle's samples what the scalar functions give them:
+/// constant, flat, screen or perspective shading; uv interpolated in screen space or
+/// perspective-correct with analytic derivatives (or none); the triangle not clipped.
+bool interpolates_in_batches(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t);
+
+/// For samples i < w.count of triangle t: colour[i] = untextured_colour at weights w, and lane i of
+/// `lookups` = texture_lookup's uv and derivatives as floats (lookups.count = w.count).
+void interpolate_batch(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t,
+                       const VertexValues& colors, const TriangleUvs& uvs, const BatchWeights& w, glm::vec4* colour,
+                       LookupBatch& lookups);
+
+}  // namespace kernels
+}  // namespace mipraster
