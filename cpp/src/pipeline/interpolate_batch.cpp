@@ -21,7 +21,7 @@ constexpr int kWidth = 4;
     std::memcpy(&r, p, sizeof r);
     return r;
 }
-[[gnu::always_inline]] inline void store(float* p, Doubles x) {
+[[gnu::always_inline]] inline void store(float* p, const Doubles& x) {
     const Floats f = __builtin_convertvector(x, Floats);
     std::memcpy(p, &f, sizeof f);
 }
