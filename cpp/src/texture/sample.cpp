@@ -259,9 +259,10 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
     return p;
 }
 
-// Texel indices and fractions of probes k0 … k0 + n − 1 (n ≤ 16) on a line inside a level: x = x0 +
-// k·step·sx ≥ 0 (likewise y), i = ⌊x⌋ by truncation. Two probes per SSE2 vector: element by element
+// Texel indices and fractions of probes k0 … k0 + n − 1 (n ≤ 16) on a line within ±kProbeReach
+// texels: x = x0 + k·step·sx (likewise y), i = ⌊x⌋. Two probes per SSE2 vector: element by element
 // the arithmetic of one probe at a time, so the bits are the same.
+constexpr double kProbeReach = 0x1p30;  // ⌊x⌋ + 1 fits an int, with room for wrap_index
 struct ProbePositions {
     std::int32_t i[16], j[16];
     float fx[16], fy[16];
@@ -269,10 +270,13 @@ struct ProbePositions {
     void fill(int k0, int n, double step, double x0, double sx, double y0, double sy) {
         typedef double Doubles __attribute__((vector_size(16)));
         typedef std::int32_t Ints __attribute__((vector_size(8)));
+        typedef std::int64_t Masks __attribute__((vector_size(16)));
         typedef float Floats __attribute__((vector_size(8)));
         const auto axis = [&](Doubles t, double origin, double slope, std::int32_t* index, float* fraction, int c) {
             const Doubles x = origin + t * slope;
-            const Ints whole = __builtin_convertvector(x, Ints);
+            const Ints truncated = __builtin_convertvector(x, Ints);
+            const Masks below = x < __builtin_convertvector(truncated, Doubles);  // −1 where x < 0 is not whole
+            const Ints whole = truncated + __builtin_convertvector(below, Ints);
             const Floats f = __builtin_convertvector(x - __builtin_convertvector(whole, Doubles), Floats);
             std::memcpy(index + c, &whole, sizeof whole);
             std::memcpy(fraction + c, &f, sizeof f);
@@ -294,10 +298,10 @@ template <TexelFilter kFilter>
 [[gnu::noinline]] Texel probe_mean(const AnisoProbes& p, double u, double v, const TextureLevel& level, const Sampler& s) {
     const double step = 1.0 / p.count;
     if constexpr (kFilter == TexelFilter::linear) {
-        // Bilinear quads at x = u·w − ½ + o·du·w: when both end quads lie inside the level (so do
-        // all between: rounding is monotonic), no probe wraps, and positions step along the line
-        // with neither wrapping nor floor. Repeat and mirror first move the centre by whole
-        // periods (each probe would be moved alike); clamp and border do not move it.
+        // Bilinear quads at x = u·w − ½ + o·du·w, stepping along the line. Repeat and mirror first
+        // move the centre by whole periods (each probe would be moved alike); clamp and border do
+        // not move it. When both end quads lie inside the level (so do all between: rounding is
+        // monotonic), no probe wraps; otherwise the quads that reach outside wrap texel by texel.
         const auto periodic = [](WrapMode mode) { return mode == WrapMode::repeat || mode == WrapMode::mirror; };
         const double cx = periodic(s.wrap_u) ? reduce(u * level.width, level.width, s.wrap_u) : u * level.width;
         const double cy = periodic(s.wrap_v) ? reduce(v * level.height, level.height, s.wrap_v) : v * level.height;
@@ -305,16 +309,23 @@ template <TexelFilter kFilter>
         const double x0 = cx - 0.5 + (0.5 * step - 0.5) * sx, y0 = cy - 0.5 + (0.5 * step - 0.5) * sy;
         const double x1 = x0 + (p.count - 1) * step * sx, y1 = y0 + (p.count - 1) * step * sy;
         const double last_x = level.width - 1, last_y = level.height - 1;
-        if (std::min(x0, x1) >= 0.0 && std::max(x0, x1) < last_x && std::min(y0, y1) >= 0.0 &&
-            std::max(y0, y1) < last_y) {
+        const bool inside = std::min(x0, x1) >= 0.0 && std::max(x0, x1) < last_x && std::min(y0, y1) >= 0.0 &&
+                            std::max(y0, y1) < last_y;
+        const bool near = std::min(x0, x1) > -kProbeReach && std::max(x0, x1) < kProbeReach &&
+                          std::min(y0, y1) > -kProbeReach && std::max(y0, y1) < kProbeReach;  // (false for NaN)
+        if (inside || near) {
             const std::size_t w = level.width;
             const glm::vec4* texels = level.texels.data();
             // Positions a chunk at a time, two probes per vector (the same double arithmetic as
             // one at a time), then the blends in probe order.
             constexpr int kChunk = 16;
+            const unsigned quads_x = level.width - 1, quads_y = level.height - 1;  // quads with no wrapping
             ProbePositions at;
             const auto quad = [&](int c) {
-                const glm::vec4* q = texels + static_cast<std::size_t>(at.j[c]) * w + at.i[c];
+                const int i = at.i[c], j = at.j[c];
+                if (!inside && !(static_cast<unsigned>(i) < quads_x && static_cast<unsigned>(j) < quads_y))
+                    return bilinear_wrapped(level, i, j, at.fx[c], at.fy[c], s);
+                const glm::vec4* q = texels + static_cast<std::size_t>(j) * w + i;
                 return lerp_quad(load(q[0]), load(q[1]), load(q[w]), load(q[w + 1]), at.fx[c], at.fy[c]);
             };
             Texel first = splat(0.0f), difference = splat(0.0f);
