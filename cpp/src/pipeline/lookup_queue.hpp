@@ -27,7 +27,7 @@ public:
     LookupQueue& operator=(const LookupQueue&) = delete;
 
     /// The triangle whose samples the next pushes are, with its vertex colours and uvs (copied:
-    /// the caller's change with the next triangle).
+    /// the caller's copies change with the next triangle).
     void begin_triangle(const SetupTriangle& t, const VertexValues& colors, const TriangleUvs& uvs,
                         const ClipWeights* clip_weights) {
         if (current_queued_) ++current_;  // keep the triangle of the samples already queued
