@@ -105,6 +105,13 @@ Texel nearest(const TextureLevel& level, double u, double v, const Sampler& s) {
                      fetch(level, i + 1, j + 1, s), ax, ay);
 }
 
+// The quad at (i, j) when it lies inside the level (i + 1 < width, j + 1 < height).
+inline Texel inside_quad(const TextureLevel& level, int i, int j, float ax, float ay) {
+    const std::size_t w = level.width;
+    const glm::vec4* q = level.texels.data() + static_cast<std::size_t>(j) * w + i;
+    return lerp_quad(load(q[0]), load(q[1]), load(q[w]), load(q[w + 1]), ax, ay);
+}
+
 // Bilinear between the four nearest texel centres, i = ⌊u·w − ½⌋. Positions and fractions are
 // found in double (so large textures and far repeats keep their sub-texel phase); the texels
 // are blended in float.
@@ -113,11 +120,8 @@ inline Texel bilinear(const TextureLevel& level, double u, double v, const Sampl
     const double y = reduce(v * level.height, level.height, s.wrap_v) - 0.5;
     if (x >= 0.0 && y >= 0.0) {  // truncation is the floor: one dependent step less than floor_int
         const int i = static_cast<int>(x), j = static_cast<int>(y);
-        if (i + 1 < level.width && j + 1 < level.height) {  // no wrapping: most lookups
-            const glm::vec4* row = &level.at(i, j);
-            return lerp_quad(load(row[0]), load(row[1]), load(row[level.width]), load(row[level.width + 1]),
-                             static_cast<float>(x - i), static_cast<float>(y - j));
-        }
+        if (i + 1 < level.width && j + 1 < level.height)  // no wrapping: most lookups
+            return inside_quad(level, i, j, static_cast<float>(x - i), static_cast<float>(y - j));
     }
     const int i = floor_int(x), j = floor_int(y);
     return bilinear_wrapped(level, i, j, static_cast<float>(x - i), static_cast<float>(y - j), s);
@@ -314,8 +318,6 @@ template <TexelFilter kFilter>
         const bool near = std::min(x0, x1) > -kProbeReach && std::max(x0, x1) < kProbeReach &&
                           std::min(y0, y1) > -kProbeReach && std::max(y0, y1) < kProbeReach;  // (false for NaN)
         if (inside || near) {
-            const std::size_t w = level.width;
-            const glm::vec4* texels = level.texels.data();
             // Positions a chunk at a time, two probes per vector (the same double arithmetic as
             // one at a time), then the blends in probe order.
             constexpr int kChunk = 16;
@@ -325,8 +327,7 @@ template <TexelFilter kFilter>
                 const int i = at.i[c], j = at.j[c];
                 if (!inside && !(static_cast<unsigned>(i) < quads_x && static_cast<unsigned>(j) < quads_y))
                     return bilinear_wrapped(level, i, j, at.fx[c], at.fy[c], s);
-                const glm::vec4* q = texels + static_cast<std::size_t>(j) * w + i;
-                return lerp_quad(load(q[0]), load(q[1]), load(q[w]), load(q[w + 1]), at.fx[c], at.fy[c]);
+                return inside_quad(level, i, j, at.fx[c], at.fy[c]);
             };
             Texel first = splat(0.0f), difference = splat(0.0f);
             for (int k0 = 0; k0 < p.count; k0 += kChunk) {
