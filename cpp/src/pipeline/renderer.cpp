@@ -490,6 +490,9 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     pool.parallel_for(static_cast<std::size_t>(grid.count()), [&](std::size_t tile) {
         TileTarget target = tile_target(grid, tile, result.pattern);
         target.block_skipping = settings.block_skipping;
+        // Counted here and stored once: the kernels count per sample, and neighbouring tiles'
+        // counters share cache lines, which two threads would otherwise pass back and forth.
+        TileCounters counters;
         const bool masked = !settings.tile_mask.empty() && !settings.tile_mask[tile];
         if (masked || listed) {
             // Pixels not asked for: the clear colour, no samples drawn, no error.
@@ -536,9 +539,9 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 if (needs_depth) target.depth.fill(target.x0, target.y0, target.x1, target.y1, clear_depth4);
             }
             if (deferred && tile_overdraw(tile, chunks, target) >= kDeferredMinOverdraw)
-                rasterize_tile_deferred(tile, chunks, prepass_kernels, shading_kernels, inputs, target, tile_counters[tile]);
+                rasterize_tile_deferred(tile, chunks, prepass_kernels, shading_kernels, inputs, target, counters);
             else
-                rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
+                rasterize_tile_chunks(tile, chunks, kernels, inputs, target, counters);
         }
         for (const PixelSpan* span = first; span != last; ++span) {
             TileTarget part = target;
@@ -548,7 +551,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                     part.color.fill(part.x0, part.y0, part.x1, part.y1, settings.clear_color);
                     if (needs_depth) part.depth.fill(part.x0, part.y0, part.x1, part.y1, clear_depth4);
                 }
-                rasterize_tile_chunks(tile, chunks, kernels, inputs, part, tile_counters[tile]);
+                rasterize_tile_chunks(tile, chunks, kernels, inputs, part, counters);
             }
             if ((settings.keep_samples || S > 1) && !wide_resolve)
                 resolve_tile(part.color, part.x0, part.y0, part.x1, part.y1, settings.resolve_filter, result.color);
@@ -557,6 +560,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             if (depth_output)
                 resolve_view_depth(part.depth, part.x0, part.y0, part.x1, part.y1, clear_depth, decoder, result.depth);
         }
+        tile_counters[tile] = counters;
         if (settings.progress) {
             std::lock_guard<std::mutex> lock(progress_mutex);
             settings.progress(++tiles_done, static_cast<std::size_t>(grid.count()));
@@ -639,7 +643,9 @@ Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::v
         target.depth = {out.depth.data(), 1, 0, 0, settings.width, S};
         target.triangle_ids = out.triangle_id.data();
         target.barycentrics = {out.barycentrics.data(), 2, 0, 0, settings.width, S};
-        rasterize_tile_chunks(tile, chunks, kernels, inputs, target, tile_counters[tile]);
+        TileCounters counters;  // (stored once, as in render)
+        rasterize_tile_chunks(tile, chunks, kernels, inputs, target, counters);
+        tile_counters[tile] = counters;
     });
     add_counters(tile_counters, stats);
     stats.raster_ms = ms_since(t0);
