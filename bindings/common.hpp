@@ -27,11 +27,12 @@ using CArray = py::array_t<T, py::array::c_style | py::array::forcecast>;
 
 /// Hands a vector's storage to numpy without copying: the vector moves to the heap and a capsule,
 /// the array's base object, deletes it when the last array referring to it goes away.
-template <class T>
-py::array_t<T> vector_to_array(std::vector<T>&& values, std::vector<py::ssize_t> shape) {
-    auto owned = std::make_unique<std::vector<T>>(std::move(values));
+template <class T, class Allocator>
+py::array_t<T> vector_to_array(std::vector<T, Allocator>&& values, std::vector<py::ssize_t> shape) {
+    using Vector = std::vector<T, Allocator>;
+    auto owned = std::make_unique<Vector>(std::move(values));
     T* data = owned->data();
-    py::capsule owner(owned.get(), [](void* p) { delete static_cast<std::vector<T>*>(p); });
+    py::capsule owner(owned.get(), [](void* p) { delete static_cast<Vector*>(p); });
     owned.release();  // the capsule owns it now
     return py::array_t<T>(std::move(shape), data, owner);
 }

@@ -171,7 +171,8 @@ inline mr::Mesh random_triangles(std::size_t n, double size, std::uint64_t seed,
 }
 
 /// Whether two float buffers hold the same bits (bit-identical renders).
-inline bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+template <class Floats>
+bool same_bits(const Floats& a, const Floats& b) {
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
 }
 

@@ -21,7 +21,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 mr::Image make(int w, int h, int c, std::vector<float> values) {
     mr::Image image(w, h, c);
-    image.pixels = std::move(values);
+    image.pixels.assign(values.begin(), values.end());
     return image;
 }
 

@@ -299,6 +299,78 @@ TEST(Renderer, ProgressReportsEveryTileOnceInIncreasingOrderEndingAtTheTotal) {
     }
 }
 
+// The colour image starts unwritten (Image::unfilled): every path must write each pixel. Freed heap
+// memory is filled with a poison first, so a pixel left unwritten keeps it. The poison is the byte
+// 0xbe, which is also what AddressSanitizer writes into the first 4 KiB of every allocation.
+constexpr unsigned char kPoisonByte = 0xbe;
+
+bool holds_poison(const float* values, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) {
+        std::uint32_t bits;
+        std::memcpy(&bits, values + i, sizeof bits);
+        if (bits == 0xbebebebeu) return true;
+    }
+    return false;
+}
+
+// Leaves freed, poisoned heap blocks of `bytes` each behind (below the mmap threshold, so the next
+// allocations of that size come from them); the returned guard keeps the heap from trimming them.
+std::vector<char> poison_the_heap(std::size_t bytes) {
+    std::vector<std::vector<char>> blocks;
+    for (int i = 0; i < 16; ++i) blocks.emplace_back(bytes, static_cast<char>(kPoisonByte));
+    std::vector<char> guard(64);
+    return guard;
+}
+
+TEST(Renderer, EveryPathWritesEveryPixelOfTheUnfilledColourImage) {
+    const int W = 100, H = 70;  // 112,000-byte image: from the heap, with partial tiles
+    const std::size_t bytes = std::size_t{W} * H * 4 * sizeof(float);
+    {
+        const std::vector<char> guard = poison_the_heap(bytes);
+        const mr::Image control = mr::Image::unfilled(W, H, 4);
+        ASSERT_TRUE(holds_poison(control.pixels.data(), control.pixels.size()))
+            << "the poison does not reach a new image here, so this test could not see an unwritten pixel";
+    }
+    const mr::Mesh mesh = helpers::random_triangles(300, 0.8, 7, {-1.5, -1.2, -1.0}, {3.0, 2.4, 2.0});
+    const mr::Camera cam = mr::Camera::look_at_perspective({0.0, 0.0, 4.0}, {0, 0, 0}, {0, 1, 0}, 0.8, double(W) / H, 0.1);
+    struct Case {
+        const char* name;
+        int samples;
+        mr::AntiAliasing aa;
+        void (*adjust)(mr::RenderSettings&);
+    };
+    const Case cases[] = {
+        {"1 sample", 1, mr::AntiAliasing::ssaa, [](mr::RenderSettings&) {}},
+        {"SSAA 4", 4, mr::AntiAliasing::ssaa, [](mr::RenderSettings&) {}},
+        {"MSAA 4", 4, mr::AntiAliasing::msaa, [](mr::RenderSettings&) {}},
+        {"no deferred shading", 1, mr::AntiAliasing::ssaa, [](mr::RenderSettings& s) { s.deferred_shading = false; }},
+        {"kept samples", 4, mr::AntiAliasing::ssaa, [](mr::RenderSettings& s) { s.keep_samples = true; }},
+        {"kept samples, 1 sample", 1, mr::AntiAliasing::ssaa, [](mr::RenderSettings& s) { s.keep_samples = true; }},
+        {"lanczos3 resolve", 4, mr::AntiAliasing::ssaa,
+         [](mr::RenderSettings& s) { s.resolve_filter = mr::ResolveFilter::lanczos3; }},
+        {"error estimate", 4, mr::AntiAliasing::ssaa, [](mr::RenderSettings& s) { s.estimate_error = true; }},
+        {"tile mask", 4, mr::AntiAliasing::ssaa, [](mr::RenderSettings& s) {
+             const int tiles = ((100 + mr::kTileSize - 1) / mr::kTileSize) * ((70 + mr::kTileSize - 1) / mr::kTileSize);
+             for (int t = 0; t < tiles; ++t) s.tile_mask.push_back(t % 3 == 0);
+         }},
+        {"listed pixels", 4, mr::AntiAliasing::ssaa, [](mr::RenderSettings& s) { s.pixels = {0, 5, 250, 6999}; }},
+        {"listed pixels, 1 sample", 1, mr::AntiAliasing::ssaa, [](mr::RenderSettings& s) { s.pixels = {3, 4000}; }},
+    };
+    for (const Case& c : cases)
+        for (int threads : {1, 2}) {
+            SCOPED_TRACE(std::string(c.name) + ", " + std::to_string(threads) + " threads");
+            mr::RenderSettings s = settings(W, H, c.samples);
+            s.anti_aliasing = c.aa;
+            s.threads = threads;
+            s.clear_color = glm::vec4(0.25f, 0.5f, 0.75f, 1.0f);
+            c.adjust(s);
+            const std::vector<char> guard = poison_the_heap(bytes);
+            const mr::RenderResult r = mr::render({make_draw(mesh, glm::dmat4(1.0), mr::DrawState{})}, cam, s);
+            ASSERT_EQ(r.color.pixels.size(), std::size_t{W} * H * 4);
+            EXPECT_FALSE(holds_poison(r.color.pixels.data(), r.color.pixels.size()));
+        }
+}
+
 TEST(Renderer, StatsJsonHoldsEveryCounter) {
     mr::RenderStats st;
     st.triangles_in = 7;

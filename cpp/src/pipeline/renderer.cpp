@@ -447,7 +447,9 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     Framebuffer kept;
     if (whole_frame)
         kept = make_framebuffer(settings.width, settings.height, S, settings.clear_color, needs_depth, clear_depth);
-    result.color = Image(settings.width, settings.height, 4);
+    // Unfilled: every tile writes each of its pixels (a clear, a resolve, or the listed-pixels
+    // clear), so a zeroing pass over the whole image first would only add a serial write.
+    result.color = Image::unfilled(settings.width, settings.height, 4);
     if (depth_output) result.depth = Image(settings.width, settings.height, 1);
     if (settings.estimate_error) result.error_map = Image(settings.width, settings.height, 1);
     std::vector<TileKernel> kernels(draws.size()), prepass_kernels(draws.size());

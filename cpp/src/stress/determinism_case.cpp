@@ -12,7 +12,8 @@ using namespace stress;
 namespace {
 
 // Values that differ bit for bit (NaNs with the same payload count as equal).
-std::uint64_t differing(const std::vector<float>& a, const std::vector<float>& b) {
+template <class Floats>
+std::uint64_t differing(const Floats& a, const Floats& b) {
     if (a.size() != b.size()) return std::max(a.size(), b.size());
     std::uint64_t n = 0;
     for (std::size_t i = 0; i < a.size(); ++i) n += std::memcmp(&a[i], &b[i], sizeof(float)) != 0;

@@ -13,8 +13,8 @@ namespace mipraster {
 void advise_huge_pages(const void* data, std::size_t bytes);
 
 /// v.reserve(n), advised before anything touches the new memory.
-template <typename T>
-void reserve_on_huge_pages(std::vector<T>& v, std::size_t n) {
+template <typename T, typename Allocator>
+void reserve_on_huge_pages(std::vector<T, Allocator>& v, std::size_t n) {
     if (n <= v.capacity()) return;
     v.reserve(n);
     advise_huge_pages(v.data(), n * sizeof(T));
