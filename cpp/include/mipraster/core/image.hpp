@@ -1,5 +1,6 @@
 #pragma once
 // A plain linear-float image: (height, width, channels), row 0 at the top.
+#include <algorithm>
 #include <cstddef>
 #include <memory>
 #include <string>
@@ -38,11 +39,7 @@ struct Image {
 
     Image() = default;
     /// Zero-filled; a large one on huge pages (a render's image is written once, right away).
-    Image(int w, int h, int c) : width(w), height(h), channels(c) {
-        const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * static_cast<std::size_t>(c);
-        reserve_on_huge_pages(pixels, n);
-        pixels.resize(n, 0.0f);
-    }
+    Image(int w, int h, int c) : Image(unfilled(w, h, c)) { std::fill(pixels.begin(), pixels.end(), 0.0f); }
 
     /// With its pixels unwritten, for a caller that writes every one (a render's colour image).
     static Image unfilled(int w, int h, int c) {
