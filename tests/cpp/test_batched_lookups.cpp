@@ -162,12 +162,20 @@ TEST(BatchedLookups, BatchedInterpolationGivesTheReferenceBits) {
     // The queue interpolates a triangle's samples in vectors (interpolate_batch). Through samplers
     // BatchSampler does not cover, the lookups are the reference's own, so any difference in the
     // colour is the interpolation's: it must give the per-sample functions' bits for every
-    // shading (no vertex colours: constant; flat, screen, perspective), uv interpolation,
+    // shading (no vertex colours: constant; flat, screen, perspective; one colour per triangle), uv interpolation,
     // derivative mode, sample mode, camera and forward or deferred shading, clipped pieces included.
     const int W = 48, H = 40;
     const mr::Mesh coloured = overlapping(90, 2.5, 81);
     mr::Mesh plain = coloured;
     plain.colors.clear();
+    // One colour per triangle (the batch then skips the weighted sums), some with a +0 or −0
+    // channel (where it must not).
+    mr::Mesh tinted = coloured;
+    for (std::size_t v = 0; v < tinted.colors.size(); ++v) {
+        tinted.colors[v] = tinted.colors[v - v % 3];
+        if (v / 3 % 4 == 1) tinted.colors[v].g = 0.0f;
+        if (v / 3 % 4 == 2) tinted.colors[v].b = -0.0f;
+    }
     mr::Sampler mirror, mirror_bilinear;  // λ and derivatives; uv only (no mip levels)
     mirror.wrap_u = mirror_bilinear.wrap_u = mr::WrapMode::mirror;
     mirror_bilinear.mip_filter = mr::MipFilter::none;
@@ -180,14 +188,15 @@ TEST(BatchedLookups, BatchedInterpolationGivesTheReferenceBits) {
         {1, mr::AntiAliasing::ssaa}, {4, mr::AntiAliasing::ssaa}, {4, mr::AntiAliasing::msaa}};
     for (const mr::Sampler& sampler : {mirror, mirror_bilinear}) {
         ASSERT_FALSE(mr::BatchSampler::covers(sampler));
-        for (const mr::Mesh* mesh : {&coloured, static_cast<const mr::Mesh*>(&plain)})
+        for (const mr::Mesh* mesh : std::initializer_list<const mr::Mesh*>{&coloured, &tinted, &plain})
             for (mr::Interpolation interpolation :
                  {mr::Interpolation::perspective, mr::Interpolation::screen, mr::Interpolation::flat})
                 for (const mr::Camera* cam : {&perspective, &orthographic})
                     for (auto [samples, aa] : modes)
                         for (mr::DerivativeMode derivatives : {mr::DerivativeMode::analytic, mr::DerivativeMode::quad})
                             for (bool deferred : {false, true}) {
-                                SCOPED_TRACE(sampler.to_string() + (mesh == &plain ? ", no colours, " : ", ") +
+                                SCOPED_TRACE(sampler.to_string() +
+                                             (mesh == &plain ? ", no colours, " : mesh == &tinted ? ", tinted, " : ", ") +
                                              mr::to_string(interpolation) +
                                              (cam == &perspective ? ", perspective, " : ", orthographic, ") +
                                              std::to_string(samples) + " " + mr::to_string(aa) + ", " +
