@@ -192,7 +192,7 @@ void bind_render(py::module_& m) {
         .def_readwrite("deferred_shading", &RenderSettings::deferred_shading,
                        "where triangles overlap deeply and every draw replaces, shade only visible samples")
         .def_readwrite("batched_lookups", &RenderSettings::batched_lookups,
-                       "look textures up eight samples at a time in float (within batch_sampling_tolerance of "
+                       "look textures up sixteen samples at a time in float (within batch_sampling_tolerance of "
                        "the double-precision reference); False: the reference for every sample")
         .def_readwrite("depth_output", &RenderSettings::depth_output,
                        "return each pixel's view-space depth (nearest sample, +inf where empty)")

@@ -3,7 +3,7 @@
 //  * framebuffer-write bandwidth: streaming stores of an RGBA float colour buffer and a float depth
 //    buffer the size of a 1920×1080 frame (20 bytes a pixel, ~41 MB: larger than the caches), by 1
 //    and by 2 threads (each thread writes its own half of the rows);
-//  * trilinear throughput: mipraster's own lookups as renders make them (BatchSampler, eight at a
+//  * trilinear throughput: mipraster's own lookups as renders make them (BatchSampler, sixteen at a
 //    time; trilinear, repeat) on a 1024² RGBA
 //    texture at a coherent pattern (a 1024-wide raster of pixels over a plane whose per-pixel uv
 //    derivatives are an isotropic footprint of d texels), lookups/s by 1 and 2 threads, for a few d
@@ -134,7 +134,7 @@ Texture make_texture() {
 
 // Lookups [lo, hi) of the coherent pattern: pixel k at (k mod 1024, k / 1024), uv advancing
 // d/1024 per pixel along x and y.
-// Through BatchSampler, eight at a time, as renders look textures up.
+// Through BatchSampler, sixteen at a time, as renders look textures up.
 glm::vec4 lookups(const TextureView& view, const Sampler& sampler, double d, std::size_t lo, std::size_t hi) {
     const float step = float(d / kTexSize);
     const glm::vec2 dx(step, 0.0f), dy(0.0f, step);

@@ -44,7 +44,7 @@ Where things are found:
 Comparable modes (OpenImageIO ↔ mipraster) are listed in :data:`COMPARABLE`; OpenImageIO reads
 a 1-channel float texture, mipraster an RGBA float one (the same values in R, G, B).
 ``trilinear_batch`` and ``anisotropic_batch`` are the trilinear and anisotropic samplers through
-``BatchSampler`` (eight lookups per call), compared with the same OpenImageIO modes.
+``BatchSampler`` (sixteen lookups per call), compared with the same OpenImageIO modes.
 
 Goals checked: anisotropic (one lookup at a time or batched) or EWA with an error (MAE, both
 textures) at or below OpenImageIO's ``aniso16_bilinear`` and at least 10× its lookups/s;

@@ -199,7 +199,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             bit for bit; False shades every sample that passes its depth test, for comparison.
         batched_lookups: textured draws whose sampler is bilinear or trilinear (isotropic, or
             anisotropic where a footprint needs one probe) with repeat or clamp wrapping look
-            their texture up eight samples at a time in float. Each lookup is within
+            their texture up sixteen samples at a time in float. Each lookup is within
             (4e-6 + 2^-22 × the texture's longer side in texels) × its largest texel value of the
             double-precision reference: 2.5e-4 for 1024 texels, and nearer 1e-7 in practice for
             power-of-two sizes. False uses the reference for every sample, for comparison.

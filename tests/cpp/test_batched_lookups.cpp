@@ -1,5 +1,5 @@
 // Batched texture lookups in the renderer (RenderSettings::batched_lookups): a render that queues
-// its lookups and runs them eight at a time through BatchSampler gives every sample the reference
+// its lookups and runs them sixteen at a time through BatchSampler gives every sample the reference
 // render's colour within the batch tolerance (per shade: the untextured colour is at most 1 and the
 // texels at most 1), the same depth and the same counters, for every shading, sample mode, blend
 // mode, deferred or forward shading and thread count. Samplers it does not cover give the

@@ -206,7 +206,9 @@ template <int W>
     std::memcpy(plan.finite + first, &finite, sizeof finite);
 }
 
-// The plan of lanes 0 … count − 1: four at a time on the baseline, eight with AVX2.
+// The plan of lanes 0 … count − 1: four at a time on the baseline, eight with AVX2. Sixteen lanes
+// are two (or four) independent chains of arithmetic back to back, which the CPU overlaps: a
+// batch of eight left the planner waiting on one chain's latency.
 void plan_sse2(const LookupBatch& b, const float* rho2_scale, int count, const Sampler& s, int width, int height,
                int levels, LanePlan& plan) {
     for (int first = 0; first < count; first += 4) plan_lanes<4>(b, rho2_scale, first, s, width, height, levels, plan);
@@ -214,7 +216,7 @@ void plan_sse2(const LookupBatch& b, const float* rho2_scale, int count, const S
 #if defined(__x86_64__)
 [[gnu::target("avx2")]] void plan_avx2(const LookupBatch& b, const float* rho2_scale, int, const Sampler& s, int width,
                                       int height, int levels, LanePlan& plan) {
-    plan_lanes<8>(b, rho2_scale, 0, s, width, height, levels, plan);
+    for (int first = 0; first < kLookupBatch; first += 8) plan_lanes<8>(b, rho2_scale, first, s, width, height, levels, plan);
 }
 #else  // (other CPUs: the four-lane path; never called)
 void plan_avx2(const LookupBatch& b, const float* rho2_scale, int count, const Sampler& s, int width, int height,

@@ -65,7 +65,7 @@ struct RenderSettings {
     /// image is the same bit for bit, and so are the counters but shader_invocations; false
     /// always shades while rasterizing, for comparison.
     bool deferred_shading = true;
-    /// Textured draws look their texture up eight samples at a time in float vectors where the
+    /// Textured draws look their texture up sixteen samples at a time in float vectors where the
     /// sampler allows (BatchSampler: bilinear or trilinear, repeat or clamp), each value within
     /// batch_sampling_tolerance of the double-precision reference sample_texture; false calls
     /// the reference for every sample.

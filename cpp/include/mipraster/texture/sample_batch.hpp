@@ -1,5 +1,5 @@
 #pragma once
-// Texture lookups eight at a time: the footprint, λ and texel positions of all eight in float
+// Texture lookups sixteen at a time: the footprint, λ and texel positions of all of them in float
 // vectors, then one trilinear blend per lookup (or one line of anisotropic probes per level).
 // The fast path for the common samplers (bilinear, trilinear and anisotropic, repeat or clamp);
 // sample_texture (sample.hpp, double positions) stays the reference it is tested against.
@@ -13,7 +13,7 @@
 
 namespace mipraster {
 
-inline constexpr int kLookupBatch = 8;
+inline constexpr int kLookupBatch = 16;
 
 /// Up to kLookupBatch lookups, one per lane: what sample_texture takes, as arrays.
 /// Lanes past `count` are read but not used (zero-initialized, so they hold defined values).
