@@ -3,6 +3,7 @@
 // non-finite triangles dropped and counted, and an empty draw list rendering the clear colour.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -315,6 +316,24 @@ bool holds_poison(const float* values, std::size_t n) {
 
 // Leaves freed, poisoned heap blocks of `bytes` each behind (below the mmap threshold, so the next
 // allocations of that size come from them); the returned guard keeps the heap from trimming them.
+TEST(Renderer, ImagesStartOnACacheLine) {
+    // Tiles of one render write the colour image from several threads; with the image on a
+    // cache line (and rows a multiple of 64 bytes) no line straddles two tiles.
+    const auto aligned = [](const mr::Image& image) {
+        return reinterpret_cast<std::uintptr_t>(image.pixels.data()) % 64 == 0;
+    };
+    for (auto [w, h, c] : {std::array<int, 3>{1, 1, 1}, {3, 5, 4}, {1920, 1080, 4}, {640, 7, 1}}) {
+        SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(c));
+        std::vector<char> odd(13);  // (so the allocator's next block is not aligned by chance alone)
+        EXPECT_TRUE(aligned(mr::Image::unfilled(w, h, c)));
+        EXPECT_TRUE(aligned(mr::Image(w, h, c)));
+    }
+    const mr::Mesh mesh = random_triangles(50, 1.0, 9);
+    const mr::Camera cam = mr::Camera::look_at_perspective({0.3, 1.0, 4.0}, {0, 0, 0}, {0, 1, 0}, 1.0, 33.0 / 21, 0.05);
+    const mr::RenderResult r = mr::render({make_draw(mesh, glm::dmat4(1.0), mr::DrawState{})}, cam, settings(33, 21, 1));
+    EXPECT_TRUE(aligned(r.color));
+}
+
 std::vector<char> poison_the_heap(std::size_t bytes) {
     std::vector<std::vector<char>> blocks;
     for (int i = 0; i < 16; ++i) blocks.emplace_back(bytes, static_cast<char>(kPoisonByte));

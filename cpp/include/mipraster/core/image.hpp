@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <memory>
+#include <new>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,9 +13,12 @@
 namespace mipraster {
 
 /// std::allocator, except that resize(n) leaves new elements default-initialized (for float:
-/// unwritten), so a buffer that is about to be overwritten whole costs no zeroing pass.
+/// unwritten), so a buffer that is about to be overwritten whole costs no zeroing pass, and
+/// that buffers start on a cache line: tiles of a render write their own rows of one image from
+/// different threads, and a line shared across a tile's edge would pass between their cores.
 template <typename T>
 struct DefaultInitAllocator : std::allocator<T> {
+    static constexpr std::size_t kAlignment = 64;  // bytes: a cache line
     template <typename U>
     struct rebind {
         using other = DefaultInitAllocator<U>;
@@ -22,6 +26,11 @@ struct DefaultInitAllocator : std::allocator<T> {
     DefaultInitAllocator() = default;
     template <typename U>
     DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+    T* allocate(std::size_t n) {
+        if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
+        return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{kAlignment}));
+    }
+    void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, std::align_val_t{kAlignment}); }
     template <typename U, typename... Args>
     void construct(U* p, Args&&... args) {
         if constexpr (sizeof...(Args) == 0) ::new (static_cast<void*>(p)) U;
