@@ -5,12 +5,18 @@
 // per sample that ends up drawn. Blending and MSAA renders are never deferred.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
 #include <cstdint>
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include "helpers.hpp"
+#include "mipraster/pipeline/binning.hpp"
+#include "mipraster/pipeline/triangle_setup.hpp"
 
 namespace {
 
@@ -151,6 +157,68 @@ TEST(DeferredShading, BlendingMsaaAndShallowScenesShadeWhileRasterizing) {
         EXPECT_EQ(o.deferred.stats.tiles_deferred, 0u);
         EXPECT_EQ(o.deferred.stats.shader_invocations, o.forward.stats.shader_invocations);
     }
+}
+
+// The overlap estimate that decides deferring (tile_overlap_area, added up while binning) against
+// independent values: a triangle inside the rectangle counts its own area (the shoelace formula on
+// its screen vertices, within their snapping to 1/256 px), a rectangle inside the triangle counts
+// whole, one its bounding box misses counts nothing, and no estimate leaves [0, rectangle area].
+TEST(DeferredShading, OverlapAreaIsTheTriangleOrTheRectangleWhereOneHoldsTheOther) {
+    std::mt19937_64 rng(44);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const int N = 256;
+    mr::Viewport vp;
+    vp.width = vp.height = N;
+    int inside = 0, covered = 0, missed = 0;
+    for (int k = 0; k < 80000; ++k) {
+        const double size = std::array<double, 4>{0.7, 4.0, 30.0, 600.0}[k % 4];
+        const glm::dvec2 c(N * unit(rng), N * unit(rng));
+        std::array<glm::dvec2, 3> v;
+        std::array<glm::dvec4, 3> p;
+        for (int i = 0; i < 3; ++i) {
+            v[i] = c + size * glm::dvec2(unit(rng) - 0.5, unit(rng) - 0.5);
+            p[i] = glm::dvec4(2.0 * v[i].x / N - 1.0, 1.0 - 2.0 * v[i].y / N, 0.5, 1.0);  // screen → clip
+        }
+        mr::SetupTriangle t;
+        mr::SetupCounters counters;
+        if (!mr::setup_triangle(p, vp, mr::CullMode::none, t, counters)) continue;
+        int x0 = static_cast<int>(N * unit(rng)), y0 = static_cast<int>(N * unit(rng));
+        int x1 = x0 + 1 + static_cast<int>((N - x0) * unit(rng)), y1 = y0 + 1 + static_cast<int>((N - y0) * unit(rng));
+        x1 = std::min(x1, N), y1 = std::min(y1, N);
+        const double got = mr::tile_overlap_area(t, x0, y0, x1, y1);
+        const double rect = double(x1 - x0) * double(y1 - y0);
+        ASSERT_GE(got, 0.0);
+        ASSERT_LE(got, rect);
+        if (t.min_x >= x1 || t.max_x < x0 || t.min_y >= y1 || t.max_y < y0) {
+            ++missed;
+            EXPECT_EQ(got, 0.0);
+        } else if (t.min_x > x0 && t.max_x + 1 < x1 && t.min_y > y0 && t.max_y + 1 < y1) {
+            ++inside;
+            const double area = 0.5 * std::abs((v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[2].x - v[0].x) * (v[1].y - v[0].y));
+            double perimeter = 0.0;
+            for (int i = 0; i < 3; ++i) perimeter += glm::length(v[(i + 1) % 3] - v[i]);
+            EXPECT_NEAR(got, area, perimeter / 256.0 + 1e-9) << "triangle of size " << size;
+        } else {
+            // The rectangle inside the triangle: its corners on the inner side of every edge, by
+            // more than the snapping can move an edge.
+            bool holds = true;
+            const double orient = (v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[2].x - v[0].x) * (v[1].y - v[0].y);
+            for (int i = 0; i < 3 && holds; ++i) {
+                const glm::dvec2 a = v[i], b = v[(i + 1) % 3];
+                for (const glm::dvec2 q : {glm::dvec2(x0, y0), glm::dvec2(x1, y0), glm::dvec2(x0, y1), glm::dvec2(x1, y1)}) {
+                    const double side = ((b.x - a.x) * (q.y - a.y) - (q.x - a.x) * (b.y - a.y)) * (orient > 0 ? 1 : -1);
+                    holds = holds && side > 2.0 * glm::length(b - a);
+                }
+            }
+            if (holds) {
+                ++covered;
+                EXPECT_EQ(got, rect);
+            }
+        }
+    }
+    EXPECT_GT(inside, 2000);
+    EXPECT_GT(covered, 600);
+    EXPECT_GT(missed, 2000);
 }
 
 }  // namespace

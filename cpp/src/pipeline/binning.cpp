@@ -1,7 +1,10 @@
 #include "mipraster/pipeline/binning.hpp"
 
+#include <algorithm>
+
 #include "mipraster/core/constants.hpp"
 #include "mipraster/core/huge_pages.hpp"
+#include "tile_blocks.hpp"
 
 namespace mipraster {
 
@@ -9,21 +12,49 @@ TileGrid TileGrid::for_viewport(int width, int height) {
     return TileGrid{width, height, (width + kTileSize - 1) / kTileSize, (height + kTileSize - 1) / kTileSize};
 }
 
+double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1) {
+    const int bx0 = std::max(t.min_x, x0), bx1 = std::min(t.max_x + 1, x1);
+    const int by0 = std::max(t.min_y, y0), by1 = std::min(t.max_y + 1, y1);
+    if (bx0 >= bx1 || by0 >= by1) return 0.0;
+    // A bounding box strictly inside the rectangle holds the vertices (bounds are the floors of
+    // their positions, and a clamp to the viewport lands on the rectangle's edge), so t covers
+    // some of it and not all: only a box reaching an edge needs the corner tests.
+    const bool inside = t.min_x > x0 && t.max_x + 1 < x1 && t.min_y > y0 && t.max_y + 1 < y1;
+    if (!inside) {
+        const kernels::SampleExtent extent{std::int64_t{x0} * kSubpixelOne, std::int64_t{y0} * kSubpixelOne,
+                                           std::int64_t{x1} * kSubpixelOne - 1, std::int64_t{y1} * kSubpixelOne - 1};
+        const kernels::BlockCoverage coverage = kernels::block_coverage(t, extent);
+        if (coverage == kernels::BlockCoverage::none) return 0.0;
+        if (coverage == kernels::BlockCoverage::all) return double(x1 - x0) * double(y1 - y0);
+    }
+    constexpr double kPixelArea2 = 2.0 * double(kSubpixelOne) * double(kSubpixelOne);  // 2A units per px²
+    const double box = double(t.max_x + 1 - t.min_x) * double(t.max_y + 1 - t.min_y);
+    const double fill = std::min(1.0, 1.0 / (t.inv_area2 * kPixelArea2 * box));
+    return double(bx1 - bx0) * double(by1 - by0) * fill;
+}
+
 void bin_triangles(BinnedChunk& chunk, const TileGrid& grid) {
-    // Pass 1 counts the entries of each tile, pass 2 places triangle indices in order.
+    // Pass 1 counts the entries of each tile (and adds up the area each triangle covers of it),
+    // pass 2 places triangle indices in order.
     chunk.tile_start.assign(static_cast<std::size_t>(grid.count()) + 1, 0);
+    chunk.tile_area.assign(static_cast<std::size_t>(grid.count()), 0.0);
     auto for_each_tile = [&](const SetupTriangle& t, auto&& visit) {
         for (int ty = t.min_y / kTileSize; ty <= t.max_y / kTileSize; ++ty)
-            for (int tx = t.min_x / kTileSize; tx <= t.max_x / kTileSize; ++tx) visit(ty * grid.tiles_x + tx);
+            for (int tx = t.min_x / kTileSize; tx <= t.max_x / kTileSize; ++tx) visit(ty * grid.tiles_x + tx, tx, ty);
     };
     for (const SetupTriangle& t : chunk.triangles)
-        for_each_tile(t, [&](int tile) { ++chunk.tile_start[static_cast<std::size_t>(tile) + 1]; });
+        for_each_tile(t, [&](int tile, int tx, int ty) {
+            ++chunk.tile_start[static_cast<std::size_t>(tile) + 1];
+            const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+            chunk.tile_area[static_cast<std::size_t>(tile)] += tile_overlap_area(
+                t, x0, y0, std::min(x0 + kTileSize, grid.width), std::min(y0 + kTileSize, grid.height));
+        });
     for (std::size_t i = 1; i < chunk.tile_start.size(); ++i) chunk.tile_start[i] += chunk.tile_start[i - 1];
     reserve_on_huge_pages(chunk.tile_triangles, chunk.tile_start.back());
     chunk.tile_triangles.resize(chunk.tile_start.back());
     std::vector<std::uint32_t> cursor(chunk.tile_start.begin(), chunk.tile_start.end() - 1);
     for (std::uint32_t i = 0; i < chunk.triangles.size(); ++i)
-        for_each_tile(chunk.triangles[i], [&](int tile) { chunk.tile_triangles[cursor[tile]++] = i; });
+        for_each_tile(chunk.triangles[i], [&](int tile, int, int) { chunk.tile_triangles[cursor[tile]++] = i; });
 }
 
 }  // namespace mipraster

@@ -225,31 +225,12 @@ void rasterize_tile_chunks(std::size_t tile, const std::vector<BinnedChunk>& chu
     }
 }
 
-// About how many times over the tile's triangles cover the target: 1 for a triangle over all of
-// it, 0 for one that misses it, else its bounding box within the target times the share of its
-// whole bounding box it fills.
+// About how many times over the tile's triangles cover it (binning added up each chunk's
+// tile_overlap_area).
 double tile_overdraw(std::size_t tile, const std::vector<BinnedChunk>& chunks, const TileTarget& target) {
-    constexpr double kPixelArea2 = 2.0 * double(kSubpixelOne) * double(kSubpixelOne);  // 2A units per px²
-    const double target_area = double(target.x1 - target.x0) * double(target.y1 - target.y0);
-    const kernels::SampleExtent extent{std::int64_t{target.x0} * kSubpixelOne, std::int64_t{target.y0} * kSubpixelOne,
-                                       std::int64_t{target.x1} * kSubpixelOne - 1, std::int64_t{target.y1} * kSubpixelOne - 1};
     double area = 0.0;
-    for (const BinnedChunk& chunk : chunks)
-        for (std::uint32_t i = chunk.tile_start[tile]; i < chunk.tile_start[tile + 1]; ++i) {
-            const SetupTriangle& t = chunk.triangles[chunk.tile_triangles[i]];
-            const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
-            const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
-            if (x0 >= x1 || y0 >= y1) continue;
-            const kernels::BlockCoverage coverage = kernels::block_coverage(t, extent);
-            if (coverage == kernels::BlockCoverage::all) {
-                area += target_area;
-            } else if (coverage == kernels::BlockCoverage::some) {
-                const double box = double(t.max_x + 1 - t.min_x) * double(t.max_y + 1 - t.min_y);
-                const double fill = std::min(1.0, 1.0 / (t.inv_area2 * kPixelArea2 * box));
-                area += double(x1 - x0) * double(y1 - y0) * fill;
-            }
-        }
-    return area / target_area;
+    for (const BinnedChunk& chunk : chunks) area += chunk.tile_area[tile];
+    return area / (double(target.x1 - target.x0) * double(target.y1 - target.y0));
 }
 
 // Deferred shading of one tile (RenderSettings::deferred_shading): the pre-pass rasterizes and

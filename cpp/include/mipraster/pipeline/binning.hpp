@@ -25,9 +25,18 @@ struct BinnedChunk {
     std::vector<ClipWeights> clip_weights;
     std::vector<std::uint32_t> tile_start;
     std::vector<std::uint32_t> tile_triangles;
+    /// Per tile, about how many pixels of it the chunk's triangles cover, overlaps counted again
+    /// (tile_overlap_area): what deciding on deferred shading sums.
+    std::vector<double> tile_area;
 };
 
-/// Fills chunk.tile_start / tile_triangles from chunk.triangles' pixel bounds (a counting sort).
+/// About how many pixels of the rectangle [x0, x1) × [y0, y1) t covers: all of them when t holds
+/// the whole rectangle, none when it misses it, else its bounding box within the rectangle times
+/// the share of its whole bounding box it fills.
+double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1);
+
+/// Fills chunk.tile_start / tile_triangles from chunk.triangles' pixel bounds (a counting sort),
+/// and chunk.tile_area while each triangle is at hand.
 void bin_triangles(BinnedChunk& chunk, const TileGrid& grid);
 
 }  // namespace mipraster
