@@ -1,5 +1,6 @@
 #pragma once
 // Every numeric constant of the pipeline, each with why it has its value and a check of its bound.
+#include <cstddef>
 #include <cstdint>
 
 namespace mipraster {
@@ -37,6 +38,15 @@ static_assert(kTileSize % 8 == 0 && kTileSize <= 256, "tile size must be a small
 /// pre-pass would only add its owner writes and the second walk over the tile.
 inline constexpr double kDeferredMinOverdraw = 1.25;
 static_assert(kDeferredMinOverdraw >= 1.0, "deferring pays only where triangles overlap");
+
+/// Freed image buffers kept for the next image of the same size (block_recycler.hpp): at most
+/// this many, each from the smallest size worth it (a 1024×1024 RGBA float image is 16 MiB) to
+/// the largest one worth holding on to, so what stays allocated is bounded by their product.
+inline constexpr int kRecycledBlocks = 2;
+inline constexpr std::size_t kMinRecycledBytes = std::size_t{4} << 20;
+inline constexpr std::size_t kMaxRecycledBytes = std::size_t{256} << 20;
+static_assert(kMinRecycledBytes <= kMaxRecycledBytes && kRecycledBlocks * kMaxRecycledBytes <= (std::size_t{1} << 30),
+              "at most 1 GiB kept");
 
 /// Clipped vertices keep w at least this large so 1/w is finite (the near plane of a sane camera
 /// is far above it; it matters only for degenerate user matrices).

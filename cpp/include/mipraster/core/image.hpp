@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "mipraster/core/block_recycler.hpp"
 #include "mipraster/core/huge_pages.hpp"
 
 namespace mipraster {
@@ -26,11 +27,16 @@ struct DefaultInitAllocator : std::allocator<T> {
     DefaultInitAllocator() = default;
     template <typename U>
     DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+    static_assert(kAlignment == 64, "block_recycler.cpp frees kept blocks with this alignment");
+    // Large buffers come from, and go back to, the blocks kept for the next image of their size.
     T* allocate(std::size_t n) {
         if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
+        if (void* kept = take_recycled_block(n * sizeof(T))) return static_cast<T*>(kept);
         return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{kAlignment}));
     }
-    void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, std::align_val_t{kAlignment}); }
+    void deallocate(T* p, std::size_t n) noexcept {
+        if (!recycle_block(p, n * sizeof(T))) ::operator delete(p, std::align_val_t{kAlignment});
+    }
     template <typename U, typename... Args>
     void construct(U* p, Args&&... args) {
         if constexpr (sizeof...(Args) == 0) ::new (static_cast<void*>(p)) U;
