@@ -45,7 +45,7 @@ bool recycle_block(void* block, std::size_t bytes) noexcept {
 void release_recycled_blocks() noexcept {
     std::lock_guard<std::mutex> lock(kept_mutex);
     for (Kept& k : kept) {
-        if (k.block) ::operator delete(k.block, std::align_val_t{64});
+        if (k.block) ::operator delete(k.block, std::align_val_t{kBlockAlignment});
         k = Kept{};
     }
 }

@@ -8,10 +8,13 @@
 
 namespace mipraster {
 
+/// The alignment of the blocks kept (and of every image buffer): a cache line.
+inline constexpr std::size_t kBlockAlignment = 64;
+
 /// A kept block of exactly `bytes` bytes (its old contents left as they were), or null.
 void* take_recycled_block(std::size_t bytes) noexcept;
 
-/// Keeps `block` (from operator new with 64-byte alignment, `bytes` long) for a later
+/// Keeps `block` (from operator new with kBlockAlignment, `bytes` long) for a later
 /// take_recycled_block; false when it is not kept (wrong size, or the keep is full): the caller
 /// frees it.
 bool recycle_block(void* block, std::size_t bytes) noexcept;

@@ -19,7 +19,7 @@ namespace mipraster {
 /// different threads, and a line shared across a tile's edge would pass between their cores.
 template <typename T>
 struct DefaultInitAllocator : std::allocator<T> {
-    static constexpr std::size_t kAlignment = 64;  // bytes: a cache line
+    static constexpr std::size_t kAlignment = kBlockAlignment;  // a cache line, as kept blocks have
     template <typename U>
     struct rebind {
         using other = DefaultInitAllocator<U>;
@@ -27,7 +27,6 @@ struct DefaultInitAllocator : std::allocator<T> {
     DefaultInitAllocator() = default;
     template <typename U>
     DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
-    static_assert(kAlignment == 64, "block_recycler.cpp frees kept blocks with this alignment");
     // Large buffers come from, and go back to, the blocks kept for the next image of their size.
     T* allocate(std::size_t n) {
         if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
