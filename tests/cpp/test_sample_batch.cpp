@@ -435,7 +435,8 @@ TEST(BatchSampler, ConstantTexturesAreReturnedExactly) {
 }
 
 // DESIGN.md §2.8 on the batch path: the four-lane (SSE2) and eight-lane (AVX2) float paths give the
-// same bits for every lookup kind, sampler and size. On a CPU without AVX2 the eight-lane path is
+// same bits for every lookup kind, sampler and size, lines of anisotropic probes included (the
+// reference's line against anisotropic_line_avx2). On a CPU without AVX2 the eight-lane path is
 // refused by name instead.
 TEST(BatchSampler, EveryVectorWidthGivesTheSameBits) {
     EXPECT_THROW(mr::BatchSampler(mr::TextureView(make_texture(kTextures[0], 1)), mr::Sampler{}, 5), std::invalid_argument);
@@ -456,7 +457,7 @@ TEST(BatchSampler, EveryVectorWidthGivesTheSameBits) {
         EXPECT_THROW(mr::BatchSampler(view, mr::Sampler{}, 8), std::invalid_argument);
         GTEST_SKIP() << "this CPU has no AVX2: only the four-lane path runs here";
     }
-    long checked = 0;
+    long checked = 0, several_probes = 0;
     for (std::size_t ti = 0; ti < std::size(kTextures); ++ti) {
         const TextureCase& tc = kTextures[ti];
         const mr::Texture tex = make_texture(tc, 4000 + ti);
@@ -476,14 +477,18 @@ TEST(BatchSampler, EveryVectorWidthGivesTheSameBits) {
                 glm::vec4 a[mr::kLookupBatch], b[mr::kLookupBatch];
                 four.sample(batch, a);
                 eight.sample(batch, b);
-                for (int lane = 0; lane < batch.count; ++lane, ++checked)
+                for (int lane = 0; lane < batch.count; ++lane, ++checked) {
+                    several_probes += surely_several_probes(view, s, lookups[lane]);
                     ASSERT_TRUE(same_bits(a[lane], b[lane]))
                         << tc.w << "x" << tc.h << " " << str(s) << "\n  " << lookups[lane].describe() << "\n  four lanes "
                         << str(a[lane]) << ", eight lanes " << str(b[lane]);
+                }
             }
         }
     }
+    std::cout << "lanes " << checked << ", several anisotropic probes " << several_probes << "\n";
     EXPECT_GE(checked, 20000);
+    EXPECT_GE(several_probes, 1000);  // (the eight-lane path's own line of probes: anisotropic_line_avx2)
 }
 
 // A lane's value does not depend on the batch around it: the same lookup alone in lane 0 and in any

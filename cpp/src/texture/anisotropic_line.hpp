@@ -1,7 +1,8 @@
 #pragma once
-// The two pieces of sample_texture's anisotropic filter that BatchSampler reuses for footprints
-// needing several probes (private to the texture module; defined in sample.cpp), so that both
-// decide magnification and step along the line with the same arithmetic.
+// The pieces of sample_texture's anisotropic filter that BatchSampler reuses for footprints
+// needing several probes (private to the texture module; defined in sample.cpp, the AVX2 line in
+// anisotropic_line_avx2.cpp), so that both decide magnification and step along the line with the
+// same arithmetic.
 #include "mipraster/texture/sampler.hpp"
 #include "mipraster/texture/texture_level.hpp"
 #include "texel.hpp"
@@ -13,9 +14,28 @@ namespace mipraster {
 /// not and log2_pmax is given, *log2_pmax is log2 Pmax (null: the log2 is skipped where it can be).
 bool anisotropic_magnifies(double pmax2, const Sampler& sampler, int levels, double* log2_pmax = nullptr);
 
+/// How far from the origin a line's probes may reach (texels) for their indices to be worked out
+/// in int: ⌊x⌋ + 1 fits, with room for wrapping.
+inline constexpr double kProbeReach = 0x1p30;
+
+/// Where the bilinear quads of anisotropic_line's probes lie on a level, in texels: probe k's at
+/// x0 + k·step·sx, y0 + k·step·sy (its top-left texel the floor), step = 1/count.
+struct ProbeLine {
+    double x0, y0, sx, sy, step;
+    bool inside;  // every probe's quad lies inside the level: none wraps
+    bool near;    // every probe within ±kProbeReach (false for NaN)
+};
+ProbeLine probe_line(const TextureLevel& level, const Sampler& sampler, double u, double v, double du, double dv,
+                     int count);
+
 /// The mean of `count` bilinear probes on one level at uv + ((i + ½)/count − ½)·(du, dv), i < count
 /// (EXT_texture_filter_anisotropic's line along the longer derivative).
 texel::Texel anisotropic_line(const TextureLevel& level, const Sampler& sampler, double u, double v, double du,
                               double dv, int count);
+
+/// anisotropic_line's bits with AVX2 (anisotropic_line_avx2.cpp), for repeat and clamp: the
+/// probes' positions and indices four per vector. Only on a CPU with AVX2.
+texel::Texel anisotropic_line_avx2(const TextureLevel& level, const Sampler& sampler, double u, double v, double du,
+                                   double dv, int count);
 
 }  // namespace mipraster

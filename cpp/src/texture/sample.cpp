@@ -263,10 +263,34 @@ AnisoProbes aniso_probes(const Footprint& f, glm::vec2 dx, glm::vec2 dy, const S
     return p;
 }
 
+}  // namespace
+
+ProbeLine probe_line(const TextureLevel& level, const Sampler& s, double u, double v, double du, double dv, int count) {
+    // Bilinear quads at x = u·w − ½ + o·du·w, stepping along the line. Repeat and mirror first
+    // move the centre by whole periods (each probe would be moved alike); clamp and border do
+    // not move it. When both end quads lie inside the level (so do all between: rounding is
+    // monotonic), no probe wraps; otherwise the quads that reach outside wrap texel by texel.
+    const auto periodic = [](WrapMode mode) { return mode == WrapMode::repeat || mode == WrapMode::mirror; };
+    const double cx = periodic(s.wrap_u) ? reduce(u * level.width, level.width, s.wrap_u) : u * level.width;
+    const double cy = periodic(s.wrap_v) ? reduce(v * level.height, level.height, s.wrap_v) : v * level.height;
+    ProbeLine line;
+    line.step = 1.0 / count;
+    line.sx = du * level.width, line.sy = dv * level.height;
+    line.x0 = cx - 0.5 + (0.5 * line.step - 0.5) * line.sx, line.y0 = cy - 0.5 + (0.5 * line.step - 0.5) * line.sy;
+    const double x1 = line.x0 + (count - 1) * line.step * line.sx, y1 = line.y0 + (count - 1) * line.step * line.sy;
+    const double last_x = level.width - 1, last_y = level.height - 1;
+    line.inside = std::min(line.x0, x1) >= 0.0 && std::max(line.x0, x1) < last_x && std::min(line.y0, y1) >= 0.0 &&
+                  std::max(line.y0, y1) < last_y;
+    line.near = std::min(line.x0, x1) > -kProbeReach && std::max(line.x0, x1) < kProbeReach &&
+                std::min(line.y0, y1) > -kProbeReach && std::max(line.y0, y1) < kProbeReach;  // (false for NaN)
+    return line;
+}
+
+namespace {
+
 // Texel indices and fractions of probes k0 … k0 + n − 1 (n ≤ 16) on a line within ±kProbeReach
 // texels: x = x0 + k·step·sx (likewise y), i = ⌊x⌋. Two probes per SSE2 vector: element by element
 // the arithmetic of one probe at a time, so the bits are the same.
-constexpr double kProbeReach = 0x1p30;  // ⌊x⌋ + 1 fits an int, with room for wrap_index
 struct ProbePositions {
     std::int32_t i[16], j[16];
     float fx[16], fy[16];
@@ -306,18 +330,9 @@ template <TexelFilter kFilter>
         // move the centre by whole periods (each probe would be moved alike); clamp and border do
         // not move it. When both end quads lie inside the level (so do all between: rounding is
         // monotonic), no probe wraps; otherwise the quads that reach outside wrap texel by texel.
-        const auto periodic = [](WrapMode mode) { return mode == WrapMode::repeat || mode == WrapMode::mirror; };
-        const double cx = periodic(s.wrap_u) ? reduce(u * level.width, level.width, s.wrap_u) : u * level.width;
-        const double cy = periodic(s.wrap_v) ? reduce(v * level.height, level.height, s.wrap_v) : v * level.height;
-        const double sx = p.du * level.width, sy = p.dv * level.height;
-        const double x0 = cx - 0.5 + (0.5 * step - 0.5) * sx, y0 = cy - 0.5 + (0.5 * step - 0.5) * sy;
-        const double x1 = x0 + (p.count - 1) * step * sx, y1 = y0 + (p.count - 1) * step * sy;
-        const double last_x = level.width - 1, last_y = level.height - 1;
-        const bool inside = std::min(x0, x1) >= 0.0 && std::max(x0, x1) < last_x && std::min(y0, y1) >= 0.0 &&
-                            std::max(y0, y1) < last_y;
-        const bool near = std::min(x0, x1) > -kProbeReach && std::max(x0, x1) < kProbeReach &&
-                          std::min(y0, y1) > -kProbeReach && std::max(y0, y1) < kProbeReach;  // (false for NaN)
-        if (inside || near) {
+        const ProbeLine line = probe_line(level, s, u, v, p.du, p.dv, p.count);
+        const bool inside = line.inside;
+        if (line.near) {
             // Positions a chunk at a time, two probes per vector (the same double arithmetic as
             // one at a time), then the blends in probe order.
             constexpr int kChunk = 16;
@@ -332,7 +347,7 @@ template <TexelFilter kFilter>
             Texel first = splat(0.0f), difference = splat(0.0f);
             for (int k0 = 0; k0 < p.count; k0 += kChunk) {
                 const int n = std::min(kChunk, p.count - k0);
-                at.fill(k0, n, step, x0, sx, y0, sy);
+                at.fill(k0, n, step, line.x0, line.sx, line.y0, line.sy);
                 int c = 0;
                 if (k0 == 0) first = quad(c++);
                 for (; c < n; ++c) difference += quad(c) - first;

@@ -315,6 +315,7 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     std::fill(lines.rho2_scale, lines.rho2_scale + kLookupBatch, 1.0f);
     const bool some_lines = s.footprint == FootprintFilter::anisotropic &&
                             probe_lines(b, n, texture_.width(), texture_.height(), levels, s, lines);
+    const auto line_mean = vector_width_ == 8 ? anisotropic_line_avx2 : anisotropic_line;
     LanePlan plan;
     (vector_width_ == 8 ? plan_avx2 : plan_sse2)(b, lines.rho2_scale, n, s, texture_.width(), texture_.height(), levels,
                                                  plan);
@@ -326,7 +327,7 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
         if (some_lines && lines.count[l] > 1) {  // the reference's line of probes, on the plan's level(s)
             const double du = lines.along_x[l] ? b.dudx[l] : b.dudy[l], dv = lines.along_x[l] ? b.dvdx[l] : b.dvdy[l];
             const auto line = [&](int k) {
-                return anisotropic_line(texture_.level(k), s, b.u[l], b.v[l], du, dv, lines.count[l]);
+                return line_mean(texture_.level(k), s, b.u[l], b.v[l], du, dv, lines.count[l]);
             };
             Texel c = line(plan.level[l]);
             if (plan.level_weight[l] > 0.0f) c = lerp(c, line(plan.level[l] + 1), plan.level_weight[l]);

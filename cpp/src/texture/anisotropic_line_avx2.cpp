@@ -1,0 +1,111 @@
+// anisotropic_line with AVX2 (anisotropic_line.hpp), for the samplers BatchSampler covers. The
+// bits are the reference's: each probe's position is the same double arithmetic, four per vector
+// instead of two, with ⌊x⌋ one rounding instruction (exact) instead of a truncation and a compare;
+// its quad is the same four texels blended the same way; the line's sum runs in probe order. A
+// line that reaches outside the level wraps four indices per vector instead of texel by texel.
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+
+#include "anisotropic_line.hpp"
+
+namespace mipraster {
+
+using namespace texel;
+
+#if defined(__x86_64__)
+
+namespace {
+
+constexpr int kChunk = 16;  // probes placed at a time
+
+// wrap_index for repeat or clamp of four indices within ±(kProbeReach + 1). Repeat: a power-of-two
+// size masks (two's complement); another subtracts n·trunc(i/n), the quotient from a double
+// division. That remainder is in (−n, n) unless the division rounded across an integer (only for
+// n ≥ 2²³), which leaves it in (−2n, 2n); the last steps bring either into [0, n).
+[[gnu::target("avx2")]] inline __m128i wrap(__m128i i, int n, WrapMode mode) {
+    const __m128i size = _mm_set1_epi32(n);
+    if (mode == WrapMode::clamp) return _mm_min_epi32(_mm_max_epi32(i, _mm_setzero_si128()), _mm_sub_epi32(size, _mm_set1_epi32(1)));
+    if ((n & (n - 1)) == 0) return _mm_and_si128(i, _mm_set1_epi32(n - 1));
+    const __m128i q = _mm256_cvttpd_epi32(_mm256_div_pd(_mm256_cvtepi32_pd(i), _mm256_set1_pd(n)));
+    __m128i r = _mm_sub_epi32(i, _mm_mullo_epi32(q, size));  // within (−2n, 2n)
+    for (int pass = 0; pass < 2; ++pass) r = _mm_add_epi32(r, _mm_and_si128(_mm_cmpgt_epi32(_mm_setzero_si128(), r), size));
+    return _mm_sub_epi32(r, _mm_andnot_si128(_mm_cmpgt_epi32(size, r), size));
+}
+
+// Probes k0 … k0 + n − 1 of a line: for each, the quad's four texels (indices into the level) and
+// its fractions.
+struct Probes {
+    std::int32_t texel[4][kChunk];
+    float fx[kChunk], fy[kChunk];
+};
+
+[[gnu::target("avx2")]] void place(const ProbeLine& g, int k0, int n, int w, int h, bool wraps, const Sampler& s,
+                                   Probes& p) {
+    const __m256d step = _mm256_set1_pd(g.step);
+    for (int c = 0; c < n; c += 4) {  // (a last partial vector places probes past the line's end: unread)
+        const __m256d k = _mm256_add_pd(_mm256_set1_pd(k0 + c), _mm256_setr_pd(0.0, 1.0, 2.0, 3.0));
+        const __m256d t = _mm256_mul_pd(k, step);
+        const __m256d x = _mm256_add_pd(_mm256_set1_pd(g.x0), _mm256_mul_pd(t, _mm256_set1_pd(g.sx)));
+        const __m256d y = _mm256_add_pd(_mm256_set1_pd(g.y0), _mm256_mul_pd(t, _mm256_set1_pd(g.sy)));
+        const __m256d fx = _mm256_floor_pd(x), fy = _mm256_floor_pd(y);
+        _mm_storeu_ps(p.fx + c, _mm256_cvtpd_ps(_mm256_sub_pd(x, fx)));
+        _mm_storeu_ps(p.fy + c, _mm256_cvtpd_ps(_mm256_sub_pd(y, fy)));
+        // Past the line's end a position may exceed the int range: the conversion gives INT_MIN there.
+        __m128i i0 = _mm256_cvttpd_epi32(fx), j0 = _mm256_cvttpd_epi32(fy);
+        const __m128i one = _mm_set1_epi32(1);
+        __m128i i1 = _mm_add_epi32(i0, one), j1 = _mm_add_epi32(j0, one);
+        if (wraps) {
+            i0 = wrap(i0, w, s.wrap_u), i1 = wrap(i1, w, s.wrap_u);
+            j0 = wrap(j0, h, s.wrap_v), j1 = wrap(j1, h, s.wrap_v);
+        }
+        const __m128i width = _mm_set1_epi32(w);
+        const __m128i row0 = _mm_mullo_epi32(j0, width), row1 = _mm_mullo_epi32(j1, width);  // (wraps around, defined)
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[0] + c), _mm_add_epi32(row0, i0));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[1] + c), _mm_add_epi32(row0, i1));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[2] + c), _mm_add_epi32(row1, i0));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[3] + c), _mm_add_epi32(row1, i1));
+    }
+}
+
+[[gnu::target("avx2")]] Texel line_mean(const TextureLevel& level, const ProbeLine& g, int count, const Sampler& s) {
+    const glm::vec4* t = level.texels.data();
+    Probes p;
+    Texel first = splat(0.0f), difference = splat(0.0f);
+    for (int k0 = 0; k0 < count; k0 += kChunk) {
+        const int n = std::min(kChunk, count - k0);
+        place(g, k0, n, level.width, level.height, !g.inside, s, p);
+        const auto quad = [&](int c) {
+            return lerp_quad(load(t[p.texel[0][c]]), load(t[p.texel[1][c]]), load(t[p.texel[2][c]]),
+                             load(t[p.texel[3][c]]), p.fx[c], p.fy[c]);
+        };
+        int c = 0;
+        if (k0 == 0) first = quad(c++);
+        for (; c < n; ++c) difference += quad(c) - first;
+    }
+    return first + difference * splat(static_cast<float>(g.step));
+}
+
+}  // namespace
+
+[[gnu::target("avx2")]] Texel anisotropic_line_avx2(const TextureLevel& level, const Sampler& s, double u, double v,
+                                                     double du, double dv, int count) {
+    const ProbeLine g = probe_line(level, s, u, v, du, dv, count);
+    // Too far out for int indices, or on a level whose texel indices overflow an int: the reference.
+    if (!g.near || level.texels.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
+        return anisotropic_line(level, s, u, v, du, dv, count);
+    return line_mean(level, g, count, s);
+}
+
+#else  // (other CPUs never call it: BatchSampler uses it only where AVX2 is)
+
+Texel anisotropic_line_avx2(const TextureLevel& level, const Sampler& s, double u, double v, double du, double dv,
+                            int count) {
+    return anisotropic_line(level, s, u, v, du, dv, count);
+}
+
+#endif
+
+}  // namespace mipraster
