@@ -1,6 +1,8 @@
-// The process-wide memory limit and the exception raised when work would exceed it.
+// The process-wide memory limit, the exception raised when work would exceed it, and the large
+// render buffers kept between renders.
 #include <pybind11/pybind11.h>
 
+#include "mipraster/core/block_recycler.hpp"
 #include "mipraster/core/memory_limit.hpp"
 
 namespace py = pybind11;
@@ -32,6 +34,11 @@ void bind_memory(py::module_& m) {
         },
         py::arg("bytes"), "Sets the process-wide memory limit in bytes; 0 restores the default.");
     m.attr("DEFAULT_MEMORY_LIMIT") = kDefaultMemoryLimit;
+    m.def("kept_buffer_bytes", &recycled_bytes,
+          "Bytes of large render buffers (images, clip-space vertices, set-up triangles) kept after\n"
+          "renders for the next buffer of the same size, so that a loop of renders does not fault them\n"
+          "in again each frame (at most 512 MiB).");
+    m.def("release_kept_buffers", &release_recycled_blocks, "Frees the buffers kept_buffer_bytes() counts.");
 }
 
 }  // namespace mipraster::bindings

@@ -49,7 +49,16 @@ ground truths are in :mod:`mipraster.reference` and its scenes in :mod:`mipraste
 returns a :class:`CompareReport`; :mod:`mipraster.testing` (imported explicitly) builds golden-image
 tests on it.
 """
-from ._core import MemoryLimitError, linear_to_srgb, linear_to_srgb8, memory_limit, set_memory_limit, srgb_to_linear
+from ._core import (
+    MemoryLimitError,
+    kept_buffer_bytes,
+    linear_to_srgb,
+    linear_to_srgb8,
+    memory_limit,
+    release_kept_buffers,
+    set_memory_limit,
+    srgb_to_linear,
+)
 from .camera import Camera
 from .compare import CompareReport, compare
 from .image import read_image, to_srgb8, write_image
@@ -85,9 +94,11 @@ __all__ = [
     "linear_to_srgb8",
     "load_scene",
     "interpolate",
+    "kept_buffer_bytes",
     "memory_limit",
     "rasterize",
     "read_image",
+    "release_kept_buffers",
     "render",
     "resample",
     "resolve",

@@ -424,6 +424,14 @@ def memory_limit() -> int:
 def set_memory_limit(bytes: int) -> None:
     """Sets the process-wide memory limit in bytes; 0 restores the default."""
 
+def kept_buffer_bytes() -> int:
+    """Bytes of large render buffers (images, clip-space vertices, set-up triangles) kept after
+    renders for the next buffer of the same size, so that a loop of renders does not fault them
+    in again each frame (at most 512 MiB)."""
+
+def release_kept_buffers() -> None:
+    """Frees the buffers kept_buffer_bytes() counts."""
+
 # --- stress suite (issue 6) ---------------------------------------------------------------------
 
 class StressRow:

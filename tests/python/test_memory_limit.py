@@ -103,3 +103,19 @@ def test_scene_file_textures_within_the_limit(limit, tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         mr.load_scene(tmp_path / "quad.obj")
+
+
+def test_kept_buffers_are_counted_and_released():
+    """A render's large buffers stay for the next render of their size, counted by
+    kept_buffer_bytes() and freed by release_kept_buffers(); neither changes what is rendered."""
+    scene = triangle_scene()
+    camera = mr.Camera.look_at((0, 0, 2), (0, 0, 0))
+    mr.release_kept_buffers()
+    assert mr.kept_buffer_bytes() == 0
+    first = mr.render(scene, camera, 1024, 1024).color.copy()  # a 16 MiB colour image
+    assert mr.kept_buffer_bytes() >= 1024 * 1024 * 4 * 4  # (freed with the result: kept)
+    again = mr.render(scene, camera, 1024, 1024).color  # into the kept block
+    assert np.array_equal(again, first)
+    mr.release_kept_buffers()
+    assert mr.kept_buffer_bytes() == 0
+    assert np.array_equal(mr.render(scene, camera, 1024, 1024).color, first)

@@ -39,7 +39,7 @@ struct ChunkRange {
 // vertex (kNonFinite marks a NaN or infinite coordinate, e.g. from a degenerate matrix): the input
 // of clipping, setup and binning, whether it came from a camera (render) or not (rasterize).
 struct ClipSpaceGeometry {
-    std::vector<glm::dvec4> positions;
+    RecycledVector<glm::dvec4> positions;
     std::vector<std::uint8_t> outcodes;
     const std::vector<glm::uvec3>* triangles = nullptr;
     CullMode cull = CullMode::none;
@@ -587,7 +587,7 @@ Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::v
     const ClipVolume volume = make_clip_volume(settings.depth_convention, settings.width, settings.height);
     std::vector<ClipSpaceGeometry> geometry(1);
     ClipSpaceGeometry& g = geometry[0];
-    g.positions = clip_positions;
+    g.positions.assign(clip_positions.begin(), clip_positions.end());
     g.outcodes.resize(clip_positions.size());
     g.triangles = &triangles;
     g.cull = settings.cull;

@@ -39,14 +39,16 @@ static_assert(kTileSize % 8 == 0 && kTileSize <= 256, "tile size must be a small
 inline constexpr double kDeferredMinOverdraw = 1.25;
 static_assert(kDeferredMinOverdraw >= 1.0, "deferring pays only where triangles overlap");
 
-/// Freed image buffers kept for the next image of the same size (block_recycler.hpp): at most
-/// this many, each from the smallest size worth it (a 1024×1024 RGBA float image is 16 MiB) to
-/// the largest one worth holding on to, so what stays allocated is bounded by their product.
-inline constexpr int kRecycledBlocks = 2;
+/// Freed large per-render buffers kept for the next buffer of the same size (block_recycler.hpp):
+/// each from the smallest size worth it (a 1024×1024 RGBA float image is 16 MiB) to the largest
+/// one worth holding on to; at most this many, and at most this many bytes in all (the oldest go
+/// first).
+inline constexpr int kRecycledBlocks = 16;
 inline constexpr std::size_t kMinRecycledBytes = std::size_t{4} << 20;
 inline constexpr std::size_t kMaxRecycledBytes = std::size_t{256} << 20;
-static_assert(kMinRecycledBytes <= kMaxRecycledBytes && kRecycledBlocks * kMaxRecycledBytes <= (std::size_t{1} << 30),
-              "at most 1 GiB kept");
+inline constexpr std::size_t kMaxRecycledTotalBytes = std::size_t{512} << 20;
+static_assert(kMinRecycledBytes <= kMaxRecycledBytes && kMaxRecycledBytes <= kMaxRecycledTotalBytes,
+              "a block of the largest size fits the total");
 
 /// Clipped vertices keep w at least this large so 1/w is finite (the near plane of a sane camera
 /// is far above it; it matters only for degenerate user matrices).

@@ -13,13 +13,12 @@
 
 namespace mipraster {
 
-/// std::allocator, except that resize(n) leaves new elements default-initialized (for float:
-/// unwritten), so a buffer that is about to be overwritten whole costs no zeroing pass, and
-/// that buffers start on a cache line: tiles of a render write their own rows of one image from
+/// RecyclingAllocator, except that resize(n) leaves new elements default-initialized (for float:
+/// unwritten), so a buffer that is about to be overwritten whole costs no zeroing pass. Starting
+/// on a cache line matters here: tiles of a render write their own rows of one image from
 /// different threads, and a line shared across a tile's edge would pass between their cores.
 template <typename T>
-struct DefaultInitAllocator : std::allocator<T> {
-    static constexpr std::size_t kAlignment = kBlockAlignment;  // a cache line, as kept blocks have
+struct DefaultInitAllocator : RecyclingAllocator<T> {
     template <typename U>
     struct rebind {
         using other = DefaultInitAllocator<U>;
@@ -27,15 +26,6 @@ struct DefaultInitAllocator : std::allocator<T> {
     DefaultInitAllocator() = default;
     template <typename U>
     DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
-    // Large buffers come from, and go back to, the blocks kept for the next image of their size.
-    T* allocate(std::size_t n) {
-        if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
-        if (void* kept = take_recycled_block(n * sizeof(T))) return static_cast<T*>(kept);
-        return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{kAlignment}));
-    }
-    void deallocate(T* p, std::size_t n) noexcept {
-        if (!recycle_block(p, n * sizeof(T))) ::operator delete(p, std::align_val_t{kAlignment});
-    }
     template <typename U, typename... Args>
     void construct(U* p, Args&&... args) {
         if constexpr (sizeof...(Args) == 0) ::new (static_cast<void*>(p)) U;

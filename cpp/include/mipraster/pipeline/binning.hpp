@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "mipraster/core/block_recycler.hpp"
 #include "mipraster/pipeline/triangle_setup.hpp"
 
 namespace mipraster {
@@ -21,10 +22,10 @@ struct TileGrid {
 /// Processing chunks in order and each tile list in order is submission order, however the
 /// triangles were split into chunks.
 struct BinnedChunk {
-    std::vector<SetupTriangle> triangles;
+    RecycledVector<SetupTriangle> triangles;
     std::vector<ClipWeights> clip_weights;
     std::vector<std::uint32_t> tile_start;
-    std::vector<std::uint32_t> tile_triangles;
+    RecycledVector<std::uint32_t> tile_triangles;
     /// Per tile, about how many pixels of it the chunk's triangles cover, overlaps counted again
     /// (tile_overlap_area): what deciding on deferred shading sums.
     std::vector<double> tile_area;
