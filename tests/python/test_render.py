@@ -3,6 +3,7 @@ shared diagonals counted once), supersample coverage with the reported pattern, 
 the result's arrays (zero copy), determinism across threads, the demo, and every error path."""
 import concurrent.futures
 import os
+import select
 import shutil
 import subprocess
 import sysconfig
@@ -167,6 +168,36 @@ def test_concurrent_renders_from_python_threads_agree():
     sequential = mr.render(alone_scene, alone_camera, 64, 40, spp=4, threads=1).color
     for r in results:
         np.testing.assert_array_equal(r, sequential)
+
+
+def test_concurrent_two_thread_renders_and_a_forked_child_agree():
+    """Renders keep their thread pools idle for the next render: concurrent renders each get their
+    own, and a child forked after renders (without the parent's workers) renders with new ones."""
+    scene, camera = mr.Scene.demo()
+    expected = mr.render(scene, camera, 96, 64, spp=4, threads=2).color
+    with concurrent.futures.ThreadPoolExecutor(3) as pool:
+        results = list(pool.map(lambda _: mr.render(scene, camera, 96, 64, spp=4, threads=2).color, range(6)))
+    for r in results:
+        np.testing.assert_array_equal(r, expected)
+    read, write = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: render on two threads, report whether the image matches
+        try:
+            same = np.array_equal(mr.render(scene, camera, 96, 64, spp=4, threads=2).color, expected)
+            os.write(write, b"1" if same else b"0")
+        finally:
+            os._exit(0)
+    os.close(write)
+    deadline = 60.0
+    ready, _, _ = select.select([read], [], [], deadline)
+    if not ready:
+        os.kill(pid, 9)
+        os.waitpid(pid, 0)
+        pytest.fail(f"the forked child's two-thread render did not finish in {deadline:.0f} s")
+    answer = os.read(read, 1)
+    os.close(read)
+    os.waitpid(pid, 0)
+    assert answer == b"1"
 
 
 def _cli():

@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <unistd.h>
+
 #include "mipraster/core/constants.hpp"
 
 namespace mipraster {
@@ -82,6 +84,60 @@ void ThreadPool::parallel_for(std::size_t count, const std::function<void(std::s
     done_.wait(lock, [&] { return finished_ == count_ && busy_workers_ == 0; });
     task_ = nullptr;
     if (error_) std::rethrow_exception(error_);
+}
+
+namespace {
+
+constexpr std::size_t kMostIdlePools = 4;
+
+struct IdlePools {
+    std::mutex mutex;
+    std::vector<ThreadPool*> pools;
+    pid_t pid = getpid();  // the process whose threads the pools hold
+    ~IdlePools() {
+        if (pid == getpid())
+            for (ThreadPool* p : pools) delete p;
+    }
+};
+
+IdlePools& idle_pools() {
+    static IdlePools idle;
+    return idle;
+}
+
+}  // namespace
+
+void ReturnToIdle::operator()(ThreadPool* pool) const noexcept {
+    IdlePools& idle = idle_pools();
+    {
+        std::lock_guard<std::mutex> lock(idle.mutex);
+        if (idle.pid == getpid() && idle.pools.size() < kMostIdlePools) {
+            try {
+                idle.pools.push_back(pool);
+                return;
+            } catch (...) {  // (no room: delete it instead)
+            }
+        }
+    }
+    delete pool;
+}
+
+LeasedPool lease_thread_pool(int threads) {
+    IdlePools& idle = idle_pools();
+    {
+        std::lock_guard<std::mutex> lock(idle.mutex);
+        if (idle.pid != getpid()) {  // a forked child: those workers are not here (left undeleted)
+            idle.pools.clear();
+            idle.pid = getpid();
+        }
+        for (auto it = idle.pools.begin(); it != idle.pools.end(); ++it)
+            if ((*it)->size() == threads) {
+                ThreadPool* pool = *it;
+                idle.pools.erase(it);
+                return LeasedPool(pool);
+            }
+    }
+    return LeasedPool(new ThreadPool(threads));
 }
 
 }  // namespace mipraster

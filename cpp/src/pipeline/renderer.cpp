@@ -382,7 +382,8 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     const int threads = resolve_thread_count(settings.threads);
     check_memory(render_bytes(draws, settings, threads, needs_depth, depth_output),
                  "a render of " + render_description(settings.width, settings.height, settings.samples));
-    ThreadPool pool(threads);
+    const LeasedPool leased = lease_thread_pool(threads);
+    ThreadPool& pool = *leased;
     RenderStats& stats = result.stats;
     stats.threads = threads;
 
@@ -578,7 +579,8 @@ Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::v
     const std::uint64_t samples = std::uint64_t(settings.width) * std::uint64_t(settings.height) * settings.samples;
     check_memory(samples * 16 + geometry_bytes(clip_positions.size(), triangles.size()),
                  "rasterizing " + render_description(settings.width, settings.height, settings.samples));
-    ThreadPool pool(threads);
+    const LeasedPool leased = lease_thread_pool(threads);
+    ThreadPool& pool = *leased;
     RenderStats& stats = out.stats;
     stats.threads = threads;
 

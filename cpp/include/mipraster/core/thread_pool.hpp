@@ -4,6 +4,7 @@
 #include <condition_variable>
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -41,5 +42,17 @@ private:
 
 /// Number of threads to use for a request of `requested` (0 = all hardware threads).
 int resolve_thread_count(int requested);
+
+/// Gives a leased pool back to the idle ones (or deletes it when enough are idle).
+struct ReturnToIdle {
+    void operator()(ThreadPool* pool) const noexcept;
+};
+using LeasedPool = std::unique_ptr<ThreadPool, ReturnToIdle>;
+
+/// A pool of `threads` threads for one piece of work: an idle one of that size when there is one,
+/// else a new one. Creating and joining a worker costs ~50–190 µs, a few per cent of a small
+/// frame, so renders keep their pools idle (waiting on a condition variable) for the next render.
+/// Pools left from before a fork() are not reused in the child, whose workers they do not have.
+LeasedPool lease_thread_pool(int threads);
 
 }  // namespace mipraster
