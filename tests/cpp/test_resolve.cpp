@@ -78,7 +78,7 @@ double mean_tolerance(const std::vector<double>& xs) {
 TEST(Resolve, BoxResolveIsTheMeanOfEachPixelsSamplesForRandomData) {
     std::mt19937_64 rng(6);
     std::uniform_real_distribution<float> u(-1.0f, 2.0f);  // nothing clamps: out-of-range values too
-    for (int S : {1, 4, 9, 16, 25, 64}) {
+    for (int S : {1, 2, 3, 4, 8, 9, 16, 25, 32, 64}) {
         mr::Framebuffer fb;
         fb.width = 13;
         fb.height = 7;
@@ -99,6 +99,9 @@ TEST(Resolve, BoxResolveIsTheMeanOfEachPixelsSamplesForRandomData) {
                     for (double v : xs) mean += v;
                     mean /= S;
                     EXPECT_NEAR(img.at(x, y, c), mean, mean_tolerance(xs)) << "S=" << S << " pixel (" << x << ", " << y << ")";
+                    // Exactly: the double sum in sample order, divided by S, rounded to float once
+                    // (a power-of-two S multiplies by its reciprocal instead: the same bits).
+                    EXPECT_EQ(img.at(x, y, c), static_cast<float>(mean)) << "S=" << S << " pixel (" << x << ", " << y << ")";
                 }
         // A tile-local window (origin (5, 2), its own pitch) over a copy of a sub-rectangle gives
         // the same pixels there, and writes nothing outside it.
