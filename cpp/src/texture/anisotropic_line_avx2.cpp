@@ -27,12 +27,13 @@ constexpr int kChunk = 16;  // probes placed at a time
 // n ≥ 2²³), which leaves it in (−2n, 2n); the last steps bring either into [0, n).
 [[gnu::target("avx2")]] inline __m128i wrap(__m128i i, int n, WrapMode mode) {
     const __m128i size = _mm_set1_epi32(n);
-    if (mode == WrapMode::clamp) return _mm_min_epi32(_mm_max_epi32(i, _mm_setzero_si128()), _mm_sub_epi32(size, _mm_set1_epi32(1)));
+    if (mode == WrapMode::clamp) return _mm_min_epi32(_mm_max_epi32(i, _mm_setzero_si128()), _mm_set1_epi32(n - 1));
     if ((n & (n - 1)) == 0) return _mm_and_si128(i, _mm_set1_epi32(n - 1));
     const __m128i q = _mm256_cvttpd_epi32(_mm256_div_pd(_mm256_cvtepi32_pd(i), _mm256_set1_pd(n)));
     __m128i r = _mm_sub_epi32(i, _mm_mullo_epi32(q, size));  // within (−2n, 2n)
-    for (int pass = 0; pass < 2; ++pass) r = _mm_add_epi32(r, _mm_and_si128(_mm_cmpgt_epi32(_mm_setzero_si128(), r), size));
-    return _mm_sub_epi32(r, _mm_andnot_si128(_mm_cmpgt_epi32(size, r), size));
+    for (int pass = 0; pass < 2; ++pass)  // r < 0: r + n
+        r = _mm_add_epi32(r, _mm_and_si128(_mm_cmpgt_epi32(_mm_setzero_si128(), r), size));
+    return _mm_sub_epi32(r, _mm_andnot_si128(_mm_cmpgt_epi32(size, r), size));  // r ≥ n: r − n
 }
 
 // Probes k0 … k0 + n − 1 of a line: for each, the quad's four texels (indices into the level) and

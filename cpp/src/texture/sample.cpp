@@ -326,10 +326,6 @@ template <TexelFilter kFilter>
 [[gnu::noinline]] Texel probe_mean(const AnisoProbes& p, double u, double v, const TextureLevel& level, const Sampler& s) {
     const double step = 1.0 / p.count;
     if constexpr (kFilter == TexelFilter::linear) {
-        // Bilinear quads at x = u·w − ½ + o·du·w, stepping along the line. Repeat and mirror first
-        // move the centre by whole periods (each probe would be moved alike); clamp and border do
-        // not move it. When both end quads lie inside the level (so do all between: rounding is
-        // monotonic), no probe wraps; otherwise the quads that reach outside wrap texel by texel.
         const ProbeLine line = probe_line(level, s, u, v, p.du, p.dv, p.count);
         const bool inside = line.inside;
         if (line.near) {
