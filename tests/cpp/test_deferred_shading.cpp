@@ -11,6 +11,7 @@
 #include <random>
 #include <cstdint>
 #include <cstring>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -219,6 +220,80 @@ TEST(DeferredShading, OverlapAreaIsTheTriangleOrTheRectangleWhereOneHoldsTheOthe
     EXPECT_GT(inside, 2000);
     EXPECT_GT(covered, 600);
     EXPECT_GT(missed, 2000);
+}
+
+// Area of the triangle v (screen pixels) inside [x0, x1) × [y0, y1): the triangle clipped by the
+// rectangle's four sides (the other way round from the renderer, which clips the rectangle by
+// the triangle's snapped edges), then the shoelace formula.
+double triangle_in_rectangle(const std::array<glm::dvec2, 3>& v, double x0, double y0, double x1, double y1) {
+    std::vector<glm::dvec2> poly(v.begin(), v.end());
+    const auto clip = [&](auto inside_distance) {  // keeps the side where inside_distance ≥ 0
+        std::vector<glm::dvec2> out;
+        for (std::size_t k = 0; k < poly.size(); ++k) {
+            const glm::dvec2 p = poly[k], q = poly[(k + 1) % poly.size()];
+            const double dp = inside_distance(p), dq = inside_distance(q);
+            if (dp >= 0) out.push_back(p);
+            if ((dp >= 0) != (dq >= 0)) out.push_back(p + (dp / (dp - dq)) * (q - p));
+        }
+        poly = out;
+    };
+    clip([&](glm::dvec2 p) { return p.x - x0; });
+    clip([&](glm::dvec2 p) { return x1 - p.x; });
+    clip([&](glm::dvec2 p) { return p.y - y0; });
+    clip([&](glm::dvec2 p) { return y1 - p.y; });
+    double twice = 0.0;
+    for (std::size_t k = 0; k < poly.size(); ++k) {
+        const glm::dvec2 p = poly[k], q = poly[(k + 1) % poly.size()];
+        twice += p.x * q.y - q.x * p.y;
+    }
+    return 0.5 * std::abs(twice);
+}
+
+// Where a triangle wider or taller than a tile covers part of the rectangle, the estimate is its
+// area inside the rectangle (against an independent clip of its unsnapped vertices, within the
+// snapping), whether or not the triangle reaches past the viewport: a bounding box clamped to the
+// viewport no longer says how much of it the triangle fills (two large triangles sharing an edge
+// across a tile counted the tile twice over, and deferred it for nothing).
+TEST(DeferredShading, OverlapAreaOfALargeTriangleIsItsAreaInsideTheRectangle) {
+    std::mt19937_64 rng(45);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const int N = 256;
+    mr::Viewport vp;
+    vp.width = vp.height = N;
+    int partial = 0, past_viewport = 0;
+    for (int k = 0; k < 60000; ++k) {
+        const double size = std::array<double, 3>{40.0, 200.0, 2000.0}[k % 3];
+        const glm::dvec2 c(N * unit(rng), N * unit(rng));
+        std::array<glm::dvec2, 3> v;
+        std::array<glm::dvec4, 3> p;
+        for (int i = 0; i < 3; ++i) {
+            v[i] = c + size * glm::dvec2(unit(rng) - 0.5, unit(rng) - 0.5);
+            p[i] = glm::dvec4(2.0 * v[i].x / N - 1.0, 1.0 - 2.0 * v[i].y / N, 0.5, 1.0);  // screen → clip
+        }
+        mr::SetupTriangle t;
+        mr::SetupCounters counters;
+        if (!mr::setup_triangle(p, vp, mr::CullMode::none, t, counters)) continue;
+        if (t.max_x + 1 - t.min_x <= mr::kTileSize && t.max_y + 1 - t.min_y <= mr::kTileSize) continue;
+        const int x0 = static_cast<int>((N - 32) * unit(rng)), y0 = static_cast<int>((N - 32) * unit(rng));
+        const int x1 = x0 + 1 + static_cast<int>(32 * unit(rng)), y1 = y0 + 1 + static_cast<int>(32 * unit(rng));
+        const double got = mr::tile_overlap_area(t, x0, y0, x1, y1);
+        const double rect = double(x1 - x0) * double(y1 - y0);
+        const double expected = triangle_in_rectangle(v, x0, y0, x1, y1);
+        if (expected <= 0.0 || expected >= rect) continue;  // (missed or held whole: the other test)
+        double perimeter = 0.0;
+        for (int i = 0; i < 3; ++i) perimeter += glm::length(v[(i + 1) % 3] - v[i]);
+        // Snapping moves each edge by at most 1/256 px (with the top-left bias): the area inside the
+        // rectangle by at most the edges' length inside it, bounded by its perimeter.
+        const double slack = std::min(perimeter, 2.0 * (x1 - x0 + y1 - y0)) / 128.0 + 1e-9;
+        ++partial;
+        past_viewport += std::min({v[0].x, v[1].x, v[2].x}) < 0.0 || std::max({v[0].x, v[1].x, v[2].x}) > N;
+        EXPECT_NEAR(got, expected, slack) << "triangle of size " << size << ", rectangle (" << x0 << ", " << y0
+                                          << ") - (" << x1 << ", " << y1 << ")";
+    }
+    std::cout << "partly covered rectangles " << partial << ", of them by triangles past the viewport "
+              << past_viewport << "\n";
+    EXPECT_GT(partial, 2000);
+    EXPECT_GT(past_viewport, 300);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "mipraster/pipeline/binning.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "mipraster/core/constants.hpp"
 #include "mipraster/core/huge_pages.hpp"
@@ -11,6 +12,47 @@ namespace mipraster {
 TileGrid TileGrid::for_viewport(int width, int height) {
     return TileGrid{width, height, (width + kTileSize - 1) / kTileSize, (height + kTileSize - 1) / kTileSize};
 }
+
+namespace {
+
+// The area (pixels) of the rectangle [x0, x1) × [y0, y1) on t's inner side of all three edges:
+// the rectangle clipped by each edge's half-plane in turn (Sutherland–Hodgman, in double on 1/256 px
+// coordinates), then the shoelace formula. A convex polygon gains at most a corner per clip: ≤ 7.
+double clipped_area(const SetupTriangle& t, int x0, int y0, int x1, int y1) {
+    struct Point {
+        double x, y;
+    };
+    constexpr double kOne = kSubpixelOne;
+    Point polygon[8] = {{x0 * kOne, y0 * kOne}, {x1 * kOne, y0 * kOne}, {x1 * kOne, y1 * kOne}, {x0 * kOne, y1 * kOne}};
+    int n = 4;
+    for (int e = 0; e < 3; ++e) {
+        const auto value = [&](const Point& p) {
+            return double(t.edge_a[e]) * p.x + double(t.edge_b[e]) * p.y + double(t.edge_c[e]);
+        };
+        Point kept[8];
+        int m = 0;
+        for (int k = 0; k < n; ++k) {
+            const Point p = polygon[k], q = polygon[(k + 1) % n];
+            const double vp = value(p), vq = value(q);
+            if (vp >= 0.0) kept[m++] = p;
+            if ((vp >= 0.0) != (vq >= 0.0)) {
+                const double s = vp / (vp - vq);
+                kept[m++] = {p.x + s * (q.x - p.x), p.y + s * (q.y - p.y)};
+            }
+        }
+        if (m < 3) return 0.0;
+        std::copy(kept, kept + m, polygon);
+        n = m;
+    }
+    double twice_area = 0.0;
+    for (int k = 0; k < n; ++k) {
+        const Point p = polygon[k], q = polygon[(k + 1) % n];
+        twice_area += p.x * q.y - q.x * p.y;
+    }
+    return std::abs(twice_area) / (2.0 * kOne * kOne);
+}
+
+}  // namespace
 
 double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1) {
     const int bx0 = std::max(t.min_x, x0), bx1 = std::min(t.max_x + 1, x1);
@@ -26,6 +68,9 @@ double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1)
         const kernels::BlockCoverage coverage = kernels::block_coverage(t, extent);
         if (coverage == kernels::BlockCoverage::none) return 0.0;
         if (coverage == kernels::BlockCoverage::all) return double(x1 - x0) * double(y1 - y0);
+        // A triangle wider or taller than a tile that covers part of it: its bounding box says
+        // little (clamped to the viewport, it can be smaller than the triangle), so clip.
+        if (t.max_x + 1 - t.min_x > kTileSize || t.max_y + 1 - t.min_y > kTileSize) return clipped_area(t, x0, y0, x1, y1);
     }
     constexpr double kPixelArea2 = 2.0 * double(kSubpixelOne) * double(kSubpixelOne);  // 2A units per px²
     const double box = double(t.max_x + 1 - t.min_x) * double(t.max_y + 1 - t.min_y);

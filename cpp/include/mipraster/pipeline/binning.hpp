@@ -32,8 +32,9 @@ struct BinnedChunk {
 };
 
 /// About how many pixels of the rectangle [x0, x1) × [y0, y1) t covers: all of them when t holds
-/// the whole rectangle, none when it misses it, else its bounding box within the rectangle times
-/// the share of its whole bounding box it fills.
+/// the whole rectangle, none when it misses it, its area clipped to the rectangle when it is wider
+/// or taller than a tile, else its bounding box within the rectangle times the share of its whole
+/// bounding box it fills.
 double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1);
 
 /// Fills chunk.tile_start / tile_triangles from chunk.triangles' pixel bounds (a counting sort),
