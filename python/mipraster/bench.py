@@ -305,6 +305,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             ap.error(str(e))
     cases: List[Case] = []
     images: Dict[tuple, np.ndarray] = {}
+    anchor_dir = os.path.join(args.out, "llvmpipe")
+    # llvmpipe runs right after each scene's mipraster cases, not after every scene's: the shared
+    # machine's speed drifts over minutes, and a ratio is fairest between neighbouring measurements.
+    anchor_runs: Dict[tuple, dict] = {}
+    gl_renderer: Optional[str] = None
+    anchor_failed = False
     for name in names:
         bench_scene = scenes_module.make_scene(name)
         scene, camera = to_mipraster(bench_scene)
@@ -328,23 +334,27 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 images[(name, mode)] = to_rgb8_linear(result["image"])
                 print(f"mipraster {name:18s} {mode:6s} {threads}T {case.median_ms:10.2f} ms "
                       f"({case.frames} frames)", file=sys.stderr)
+        if args.no_anchor or anchor_failed:
+            continue
+        anchor = run_anchor(bench_dir, os.path.join(anchor_dir, name), [name], args.modes, args.threads, args.quick)
+        if anchor is None:
+            anchor_failed = True  # (not available: the reason is printed once)
+            continue
+        gl = next(iter(anchor.get("gl_info", {}).values()), {})
+        gl_renderer = gl_renderer or gl.get("GL_RENDERER", "?")
+        anchor_runs.update({(r["scene"], r["mode"], r["threads"]): r for r in anchor["runs"]})
 
-    anchor_dir = os.path.join(args.out, "llvmpipe")
-    anchor = None if args.no_anchor else run_anchor(bench_dir, anchor_dir, names, args.modes, args.threads,
-                                                     args.quick)
-    if anchor is None:
+    if not anchor_runs:
         note = "llvmpipe was not run (" + ("--no-anchor" if args.no_anchor else "not available, see above") + ")."
     else:
-        gl = next(iter(anchor.get("gl_info", {}).values()), {})
-        note = f"llvmpipe: {gl.get('GL_RENDERER', '?')}, measured in the same run."
-        runs = {(r["scene"], r["mode"], r["threads"]): r for r in anchor["runs"]}
+        note = f"llvmpipe: {gl_renderer}, measured in the same run, right after each scene's mipraster cases."
         for c in cases:
-            r = runs.get((c.scene, c.mode, c.threads))
+            r = anchor_runs.get((c.scene, c.mode, c.threads))
             if r is None:
                 continue
             c.llvmpipe_ms = r["median_s"] * 1e3
             c.ratio = c.median_ms / c.llvmpipe_ms
-            other = anchor_image(anchor_dir, c.scene, c.mode)
+            other = anchor_image(os.path.join(anchor_dir, c.scene), c.scene, c.mode)
             if other is not None and other.shape == images[(c.scene, c.mode)].shape:
                 c.psnr_db = psnr(images[(c.scene, c.mode)], other)
 
