@@ -160,6 +160,26 @@ TEST(DeferredShading, BlendingMsaaAndShallowScenesShadeWhileRasterizing) {
     }
 }
 
+// A random triangle of about `size` pixels around a random point of an N×N screen (its vertices
+// in pixels).
+std::array<glm::dvec2, 3> random_screen_triangle(std::mt19937_64& rng, double size, int N) {
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const glm::dvec2 c(N * unit(rng), N * unit(rng));
+    std::array<glm::dvec2, 3> v;
+    for (glm::dvec2& vertex : v) vertex = c + size * glm::dvec2(unit(rng) - 0.5, unit(rng) - 0.5);
+    return v;
+}
+
+// Sets up the screen triangle v on an N×N viewport (clip positions with w = 1); false when culled.
+bool set_up(const std::array<glm::dvec2, 3>& v, int N, mr::SetupTriangle& t) {
+    mr::Viewport vp;
+    vp.width = vp.height = N;
+    std::array<glm::dvec4, 3> p;
+    for (int i = 0; i < 3; ++i) p[i] = glm::dvec4(2.0 * v[i].x / N - 1.0, 1.0 - 2.0 * v[i].y / N, 0.5, 1.0);
+    mr::SetupCounters counters;
+    return mr::setup_triangle(p, vp, mr::CullMode::none, t, counters);
+}
+
 // The overlap estimate that decides deferring (tile_overlap_area, added up while binning) against
 // independent values: a triangle inside the rectangle counts its own area (the shoelace formula on
 // its screen vertices, within their snapping to 1/256 px), a rectangle inside the triangle counts
@@ -168,21 +188,12 @@ TEST(DeferredShading, OverlapAreaIsTheTriangleOrTheRectangleWhereOneHoldsTheOthe
     std::mt19937_64 rng(44);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     const int N = 256;
-    mr::Viewport vp;
-    vp.width = vp.height = N;
     int inside = 0, covered = 0, missed = 0;
     for (int k = 0; k < 80000; ++k) {
         const double size = std::array<double, 4>{0.7, 4.0, 30.0, 600.0}[k % 4];
-        const glm::dvec2 c(N * unit(rng), N * unit(rng));
-        std::array<glm::dvec2, 3> v;
-        std::array<glm::dvec4, 3> p;
-        for (int i = 0; i < 3; ++i) {
-            v[i] = c + size * glm::dvec2(unit(rng) - 0.5, unit(rng) - 0.5);
-            p[i] = glm::dvec4(2.0 * v[i].x / N - 1.0, 1.0 - 2.0 * v[i].y / N, 0.5, 1.0);  // screen → clip
-        }
+        const std::array<glm::dvec2, 3> v = random_screen_triangle(rng, size, N);
         mr::SetupTriangle t;
-        mr::SetupCounters counters;
-        if (!mr::setup_triangle(p, vp, mr::CullMode::none, t, counters)) continue;
+        if (!set_up(v, N, t)) continue;
         int x0 = static_cast<int>(N * unit(rng)), y0 = static_cast<int>(N * unit(rng));
         int x1 = x0 + 1 + static_cast<int>((N - x0) * unit(rng)), y1 = y0 + 1 + static_cast<int>((N - y0) * unit(rng));
         x1 = std::min(x1, N), y1 = std::min(y1, N);
@@ -258,21 +269,12 @@ TEST(DeferredShading, OverlapAreaOfALargeTriangleIsItsAreaInsideTheRectangle) {
     std::mt19937_64 rng(45);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     const int N = 256;
-    mr::Viewport vp;
-    vp.width = vp.height = N;
     int partial = 0, past_viewport = 0;
     for (int k = 0; k < 60000; ++k) {
         const double size = std::array<double, 3>{40.0, 200.0, 2000.0}[k % 3];
-        const glm::dvec2 c(N * unit(rng), N * unit(rng));
-        std::array<glm::dvec2, 3> v;
-        std::array<glm::dvec4, 3> p;
-        for (int i = 0; i < 3; ++i) {
-            v[i] = c + size * glm::dvec2(unit(rng) - 0.5, unit(rng) - 0.5);
-            p[i] = glm::dvec4(2.0 * v[i].x / N - 1.0, 1.0 - 2.0 * v[i].y / N, 0.5, 1.0);  // screen → clip
-        }
+        const std::array<glm::dvec2, 3> v = random_screen_triangle(rng, size, N);
         mr::SetupTriangle t;
-        mr::SetupCounters counters;
-        if (!mr::setup_triangle(p, vp, mr::CullMode::none, t, counters)) continue;
+        if (!set_up(v, N, t)) continue;
         if (t.max_x + 1 - t.min_x <= mr::kTileSize && t.max_y + 1 - t.min_y <= mr::kTileSize) continue;
         const int x0 = static_cast<int>((N - 32) * unit(rng)), y0 = static_cast<int>((N - 32) * unit(rng));
         const int x1 = x0 + 1 + static_cast<int>(32 * unit(rng)), y1 = y0 + 1 + static_cast<int>(32 * unit(rng));
