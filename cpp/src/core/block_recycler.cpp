@@ -19,7 +19,7 @@ struct Kept {
 std::mutex kept_mutex;
 Kept kept[kRecycledBlocks];
 std::size_t kept_bytes = 0;
-std::uint64_t clock = 0;
+std::uint64_t keep_order = 0;  // counts the blocks kept so far
 
 void free_block(Kept& k) {
     ::operator delete(k.block, std::align_val_t{kBlockAlignment});
@@ -53,7 +53,7 @@ bool recycle_block(void* block, std::size_t bytes) noexcept {
             else if (!oldest || k.when < oldest->when) oldest = &k;
         }
         if (free_slot && kept_bytes + bytes <= kMaxRecycledTotalBytes) {
-            *free_slot = Kept{block, bytes, ++clock};
+            *free_slot = Kept{block, bytes, ++keep_order};
             kept_bytes += bytes;
             return true;
         }

@@ -3,7 +3,7 @@
 // colour image, its clip-space vertices and its set-up triangles anew each frame, and on a
 // virtual machine that hands freed memory back to its host, touching them again costs page
 // faults and zeroing in the kernel (a new 33 MB image: ~70 ms a frame; a million triangles'
-// set-up buffers: 1,570 faults and 7–30 ms a frame), against nothing when the pages stay. Up to
+// set-up buffers: 1,570 faults and 5–24 ms a frame), against nothing when the pages stay. Up to
 // kRecycledBlocks blocks of kMinRecycledBytes to kMaxRecycledBytes are kept, at most
 // kMaxRecycledTotalBytes in all, the oldest freed first (constants.hpp); thread-safe.
 #include <cstddef>
