@@ -272,12 +272,16 @@ def _status_bytes(key: str) -> int:
 
 def render_memory(variant: Variant, width: int, height: int) -> Optional[int]:
     """Growth of the resident set during one frame (its peak over the resident set before it), or
-    None where Linux's /proc and glibc's malloc_trim are not available. Freed heap memory is first
-    returned to the system, so the frame cannot hide its allocations in memory freed before it."""
+    None where Linux's /proc and glibc's malloc_trim are not available. Freed heap memory and the
+    buffers renders keep for the next render are first returned to the system, so the frame cannot
+    hide its allocations in memory freed or kept before it."""
+    import mipraster as mr
+
     try:
         libc = ctypes.CDLL("libc.so.6")
         state = variant.setup(width, height)
         gc.collect()
+        mr.release_kept_buffers()
         libc.malloc_trim(0)
         with open("/proc/self/clear_refs", "w") as f:
             f.write("5")  # resets VmHWM, the peak resident set, to the current one

@@ -74,7 +74,7 @@ def test_bench_omissions_end_to_end(tmp_path, monkeypatch):
 
 def test_memory_sees_the_kept_sample_buffer():
     om = next(o for o in omissions.OMISSIONS if o.name == "no resolve at 1 sample")
-    w, h = 320, 180
+    w, h = 1280, 720  # (large enough that a megabyte of other allocations cannot hide the buffer)
     with_it, without = (omissions.render_memory(v, w, h) for v in (om.with_it, om.without))
     if with_it is None:
         pytest.skip("no /proc/self/clear_refs or malloc_trim here")
