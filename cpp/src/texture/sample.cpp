@@ -324,10 +324,8 @@ struct ProbePositions {
 // an anisotropic lookup's time.
 template <TexelFilter kFilter>
 [[gnu::noinline]] Texel probe_mean(const AnisoProbes& p, double u, double v, const TextureLevel& level, const Sampler& s) {
-    const double step = 1.0 / p.count;
     if constexpr (kFilter == TexelFilter::linear) {
         const ProbeLine line = probe_line(level, s, u, v, p.du, p.dv, p.count);
-        const bool inside = line.inside;
         if (line.near) {
             // Positions a chunk at a time, two probes per vector (the same double arithmetic as
             // one at a time), then the blends in probe order.
@@ -336,21 +334,22 @@ template <TexelFilter kFilter>
             ProbePositions at;
             const auto quad = [&](int c) {
                 const int i = at.i[c], j = at.j[c];
-                if (!inside && !(static_cast<unsigned>(i) < quads_x && static_cast<unsigned>(j) < quads_y))
+                if (!line.inside && !(static_cast<unsigned>(i) < quads_x && static_cast<unsigned>(j) < quads_y))
                     return bilinear_wrapped(level, i, j, at.fx[c], at.fy[c], s);
                 return inside_quad(level, i, j, at.fx[c], at.fy[c]);
             };
             Texel first = splat(0.0f), difference = splat(0.0f);
             for (int k0 = 0; k0 < p.count; k0 += kChunk) {
                 const int n = std::min(kChunk, p.count - k0);
-                at.fill(k0, n, step, line.x0, line.sx, line.y0, line.sy);
+                at.fill(k0, n, line.step, line.x0, line.sx, line.y0, line.sy);
                 int c = 0;
                 if (k0 == 0) first = quad(c++);
                 for (; c < n; ++c) difference += quad(c) - first;
             }
-            return first + difference * splat(static_cast<float>(step));
+            return first + difference * splat(static_cast<float>(line.step));
         }
     }
+    const double step = 1.0 / p.count;
     const auto probe = [&](int k) {
         const double o = (k + 0.5) * step - 0.5;
         const double pu = u + o * p.du, pv = v + o * p.dv;
