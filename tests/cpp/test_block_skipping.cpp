@@ -101,6 +101,34 @@ TEST(BlockSkipping, TileBuffersAndListedPixelsGiveThePlainImage) {
         }
 }
 
+TEST(BlockSkipping, ATriangleOverAWholeTileIsTestedAgainstEveryBlockOfIt) {
+    // Small occluders scattered over the tiles, then triangles far larger than the screen at
+    // random depths: each of those covers whole tiles, nearer than the stored depth in some of a
+    // tile's blocks and farther in others, so the whole-tile test must take every block's bound.
+    const int W = 96, H = 64;
+    for (std::uint64_t seed : {31, 32, 33})
+        for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl})
+            for (int samples : {1, 4}) {
+                SCOPED_TRACE("seed " + std::to_string(seed) + ", " + mr::to_string(convention) + ", " +
+                             std::to_string(samples) + " samples");
+                const mr::Mesh occluders = random_triangles(120, 0.25, seed, {-1.5, -1.0, -1.0}, {3.0, 2.0, 4.0});
+                const mr::Mesh walls = random_triangles(40, 60.0, seed + 100, {-0.5, -0.5, -1.5}, {1.0, 1.0, 5.0}, 0.01);
+                const std::vector<mr::Draw> draws = {make_draw(occluders, glm::dmat4(1.0), {}),
+                                                     make_draw(walls, glm::dmat4(1.0), {})};
+                const mr::Camera cam = overlap_camera(convention, W, H);
+                auto s = settings(W, H, samples);
+                s.block_skipping = false;
+                const mr::RenderResult plain = mr::render(draws, cam, s);
+                s.block_skipping = true;
+                const mr::RenderResult fast = mr::render(draws, cam, s);
+                EXPECT_GT(fast.stats.depth_blocks_rejected, 0u);
+                EXPECT_TRUE(same_bits(fast.framebuffer.color, plain.framebuffer.color)) << "samples differ";
+                EXPECT_TRUE(same_bits(fast.framebuffer.depth, plain.framebuffer.depth)) << "depth differs";
+                EXPECT_EQ(fast.stats.samples_covered, plain.stats.samples_covered);
+                EXPECT_EQ(fast.stats.samples_passed, plain.stats.samples_passed);
+            }
+}
+
 TEST(BlockSkipping, AnOccluderDrawnFirstHidesEveryBlockBehindIt) {
     // A full-screen quad at z = 1, then 50 triangles behind it at z = −1 that cover the screen:
     // each of them fails everywhere, so every block they fill is skipped and no sample passes.

@@ -109,6 +109,14 @@ public:
     /// After a depth write at pixel (x, y).
     void written(int x, int y) { known_ &= ~(std::uint32_t{1} << bit(x, y)); }
 
+    /// The bits of the blocks that hold pixels of [x0, x1) × [y0, y1) (inside the target).
+    std::uint32_t blocks_in(int x0, int y0, int x1, int y1) const {
+        std::uint32_t bits = 0;
+        for (int y = y0; y < y1; y += kBlock - (y & (kBlock - 1)))
+            for (int x = x0; x < x1; x += kBlock - (x & (kBlock - 1))) bits |= std::uint32_t{1} << bit(x, y);
+        return bits;
+    }
+
     /// Narrows the pixels [x0, x1) of row y to leave out skipped blocks at either end.
     void trim(std::uint32_t skipped, int y, int& x0, int& x1) const {
         if (!skipped) return;
@@ -121,6 +129,11 @@ public:
     template <DepthFunc kDepth>
     BlockClasses classify(const SetupTriangle& t, int x0, int y0, int x1, int y1, int S) {
         BlockClasses out;
+        // A triangle whose bounding box holds the whole target is tested on the target first: under
+        // heavy overdraw most such triangles cover all of it behind everything stored, or none of it.
+        if (x0 == target_.x0 && y0 == target_.y0 && x1 == target_.x1 && y1 == target_.y1 &&
+            whole_target<kDepth>(t, S, out))
+            return out;
         for (int by = y0 >> kBlockShift; by <= (y1 - 1) >> kBlockShift; ++by) {
             const int ry0 = std::max(y0, by << kBlockShift), ry1 = std::min(y1, (by + 1) << kBlockShift);
             for (int bx = x0 >> kBlockShift; bx <= (x1 - 1) >> kBlockShift; ++bx) {
@@ -129,8 +142,7 @@ public:
                 if (pixels < kBlockMinPixels) continue;
                 const std::uint32_t m = std::uint32_t{1} << ((by - by0_) * kBlocksPerSide + bx - bx0_);
                 // Where the samples of the pixels [rx0, rx1) × [ry0, ry1) lie.
-                const SampleExtent r{std::int64_t{rx0} * kSubpixelOne + ox0_, std::int64_t{ry0} * kSubpixelOne + oy0_,
-                                     std::int64_t{rx1 - 1} * kSubpixelOne + ox1_, std::int64_t{ry1 - 1} * kSubpixelOne + oy1_};
+                const SampleExtent r = extent(rx0, ry0, rx1, ry1);
                 const BlockCoverage coverage = block_coverage(t, r);
                 if (coverage == BlockCoverage::none) {
                     out.skipped |= m;
@@ -152,18 +164,61 @@ public:
     }
 
 private:
+    // The samples of the pixels [x0, x1) × [y0, y1).
+    SampleExtent extent(int x0, int y0, int x1, int y1) const {
+        return {std::int64_t{x0} * kSubpixelOne + ox0_, std::int64_t{y0} * kSubpixelOne + oy0_,
+                std::int64_t{x1 - 1} * kSubpixelOne + ox1_, std::int64_t{y1 - 1} * kSubpixelOne + oy1_};
+    }
+
+    // When t covers no sample of the target, or covers all and all fail the depth test: every
+    // block skipped (what the blocks one by one would give, counters included), and true.
+    template <DepthFunc kDepth>
+    bool whole_target(const SetupTriangle& t, int S, BlockClasses& out) {
+        const SampleExtent r = extent(target_.x0, target_.y0, target_.x1, target_.y1);
+        const BlockCoverage coverage = block_coverage(t, r);
+        if (coverage == BlockCoverage::none) {
+            out.skipped = blocks_in(target_.x0, target_.y0, target_.x1, target_.y1);
+            return true;
+        }
+        if constexpr (kDepth == DepthFunc::none) return false;
+        else {
+            if (coverage != BlockCoverage::all) return false;
+            const std::uint32_t blocks = blocks_in(target_.x0, target_.y0, target_.x1, target_.y1);
+            float farthest = 0.0f;
+            for (std::uint32_t m = blocks; m; m &= m - 1) {
+                const std::uint32_t b = std::uint32_t{1} << __builtin_ctz(m);
+                known_farthest<kDepth>(b);
+                const float f = farthest_[__builtin_ctz(b)];
+                if (m == blocks || (kDepth == DepthFunc::greater ? f < farthest : f > farthest)) farthest = f;
+            }
+            const float nearest = nearest_depth<kDepth>(t, r);
+            if (!(kDepth == DepthFunc::greater ? nearest <= farthest : nearest >= farthest)) return false;
+            out.skipped = blocks;
+            out.skipped_samples = static_cast<std::uint64_t>(target_.x1 - target_.x0) *
+                                  static_cast<std::uint64_t>(target_.y1 - target_.y0) * static_cast<std::uint64_t>(S);
+            out.depth_rejected = __builtin_popcount(blocks);
+            return true;
+        }
+    }
+
+    // Makes farthest_ of block m current.
+    template <DepthFunc kDepth>
+    void known_farthest(std::uint32_t m) {
+        if (!(known_ & m)) {
+            farthest_[__builtin_ctz(m)] = farthest_stored<kDepth>(__builtin_ctz(m));
+            known_ |= m;
+        }
+    }
+
     // Whether every sample of t inside the extent (in block m) fails the depth test:
     // its z is at most (at least) `nearest` and every stored depth at least (at most) the block's
     // farthest, so z > stored (z < stored) cannot hold.
     template <DepthFunc kDepth>
     bool hidden(const SetupTriangle& t, std::uint32_t m, const SampleExtent& r) {
-        const int b = __builtin_ctz(m);
-        if (!(known_ & m)) {
-            farthest_[b] = farthest_stored<kDepth>(b);
-            known_ |= m;
-        }
+        known_farthest<kDepth>(m);
         const float nearest = nearest_depth<kDepth>(t, r);
-        return kDepth == DepthFunc::greater ? nearest <= farthest_[b] : nearest >= farthest_[b];
+        const float farthest = farthest_[__builtin_ctz(m)];
+        return kDepth == DepthFunc::greater ? nearest <= farthest : nearest >= farthest;
     }
 
     // The farthest stored depth of block b within the target: the smallest for greater, the
