@@ -13,6 +13,7 @@
 #include "mipraster/pipeline/shade_texture.hpp"
 #include "mipraster/texture/sample.hpp"
 #include "lookup_queue.hpp"
+#include "sample_row.hpp"
 #include "sample_shading.hpp"
 #include "tile_blocks.hpp"
 
@@ -105,6 +106,28 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         }
         const std::int64_t step0 = t.edge_a[0] * kStep, step1 = t.edge_a[1] * kStep, step2 = t.edge_a[2] * kStep;
 
+        // A sample s of pixel (px, py) at screen weights l that passed the depth test (stored).
+        const auto passed_sample = [&](int px, int py, int s, const glm::dvec3& l) {
+            if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
+            ++counters.samples_passed;
+            if constexpr (kShading == Shading::visibility) {
+                if (target.owners) {
+                    target.owners[target.owner_index(px, py, s, S)] = owner;
+                    return;
+                }
+                const glm::dvec3 w = original_weights(t, perspective_weights(t, l), batch.clip_weights);
+                const std::size_t i = target.barycentrics.index(px, py, s);
+                target.triangle_ids[i] = static_cast<std::int32_t>(t.triangle);
+                target.barycentrics.data[2 * i] = static_cast<float>(w.y);
+                target.barycentrics.data[2 * i + 1] = static_cast<float>(w.z);
+            } else {
+                ++counters.shader_invocations;
+                shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_out.at(px, py, s),
+                                                         std::uint64_t{1}, draw, colors, uvs, t, l, batch.clip_weights,
+                                                         px, py);
+            }
+        };
+
         for (int py = y0; py < y1; ++py) {
             int rx0 = x0, rx1 = x1;  // the row without skipped blocks at its ends
             blocks.trim(cls.skipped, py, rx0, rx1);
@@ -115,6 +138,24 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             const std::int64_t row1 = t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1];
             const std::int64_t row2 = t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2];
             const int n = rx1 - rx0;
+
+            // One sample per pixel, depth tested: the row four pixels at a time (sample_row.hpp).
+            if constexpr (kMode == SampleMode::single && kDepth != DepthFunc::none) {
+                if (target.sample_rows && n >= kSampleRowMinPixels) {
+                    const std::uint32_t skipped = blocks.row_pixels(cls.skipped, py, rx0, n);
+                    const std::uint32_t untested = skipped | blocks.row_pixels(cls.hidden, py, rx0, n);
+                    const std::int64_t e[3] = {row0 + off0[0], row1 + off1[0], row2 + off2[0]};
+                    SampleRow row;
+                    if (test_sample_row(t, e, n, ~untested, kDepth, draw.depth_write, depth_out.at(rx0, py, 0), row)) {
+                        counters.samples_covered += static_cast<std::uint64_t>(count_bits(row.covered & ~skipped));
+                        for (std::uint32_t m = row.passed; m; m &= m - 1) {
+                            const int j = __builtin_ctz(m);
+                            passed_sample(rx0 + j, py, 0, glm::dvec3(row.l0[j], row.l1[j], row.l2[j]));
+                        }
+                        continue;
+                    }
+                }
+            }
 
             // Coverage masks of the row: sample s of pixel j is inside iff all three edge values are
             // ≥ 0, i.e. the sign bit of their OR is clear. Plain integer adds: this loop vectorizes on
@@ -146,10 +187,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     continue;
                 }
                 const std::int64_t p0 = row0 + j * step0, p1 = row1 + j * step1, p2 = row2 + j * step2;
-                float* const color_px = kShading == Shading::visibility ? nullptr : color_out.at(px, py, 0);
                 float* const depth_px = kDepth != DepthFunc::none ? depth_out.at(px, py, 0) : nullptr;
 
                 if constexpr (kMode == SampleMode::msaa) {
+                    float* const color_px = kShading == Shading::visibility ? nullptr : color_out.at(px, py, 0);
                     // Depth per sample, colour once per pixel: at the pixel centre when it is inside the
                     // triangle, else at the first covered sample that passed (never extrapolated).
                     std::uint64_t passed = 0;
@@ -199,25 +240,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             const float z = sample_depth(t, l);
                             if (!depth_passes<kDepth>(z, depth_px[s])) continue;
                             if (draw.depth_write) depth_px[s] = z;
-                            blocks.written(px, py);
                         }
-                        ++counters.samples_passed;
-                        if constexpr (kShading == Shading::visibility) {
-                            if (target.owners) {
-                                target.owners[target.owner_index(px, py, s, S)] = owner;
-                                continue;
-                            }
-                            const glm::dvec3 w = original_weights(t, perspective_weights(t, l), batch.clip_weights);
-                            const std::size_t i = target.barycentrics.index(px, py, s);
-                            target.triangle_ids[i] = static_cast<std::int32_t>(t.triangle);
-                            target.barycentrics.data[2 * i] = static_cast<float>(w.y);
-                            target.barycentrics.data[2 * i + 1] = static_cast<float>(w.z);
-                        } else {
-                            ++counters.shader_invocations;
-                            shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px,
-                                                                     std::uint64_t{1} << s, draw, colors, uvs, t, l,
-                                                                     batch.clip_weights, px, py);
-                        }
+                        passed_sample(px, py, s, l);
                     }
                 }
             }

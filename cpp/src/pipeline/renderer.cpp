@@ -474,6 +474,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     pool.parallel_for(static_cast<std::size_t>(grid.count()), [&](std::size_t tile) {
         TileTarget target = tile_target(grid, tile, result.pattern);
         target.block_skipping = settings.block_skipping;
+        target.sample_rows = settings.sample_rows;
         // Counted here and stored once: the kernels count per sample, and neighbouring tiles'
         // counters share cache lines, which two threads would otherwise pass back and forth.
         TileCounters counters;
@@ -652,6 +653,7 @@ std::string RenderSettings::to_string() const {
            mipraster::to_string(resolve_filter) + ", derivatives=" + mipraster::to_string(derivatives) +
            ", debug_view=" + mipraster::to_string(debug_view) +
            (estimate_error ? ", estimate_error" : "") + (block_skipping ? "" : ", no block skipping") +
+           (sample_rows ? "" : ", no sample rows") +
            (deferred_shading ? "" : ", no deferred shading") + (batched_lookups ? "" : ", no batched lookups") +
            (tile_mask.empty() ? "" : ", tile_mask=" + std::to_string(tile_mask.size()) + " tiles") +
            (pixels.empty() ? "" : ", pixels=" + std::to_string(pixels.size())) + ")";

@@ -117,6 +117,17 @@ public:
         return bits;
     }
 
+    /// Bit j set where pixel (x0 + j, y) lies in a block of `bits` (j < n ≤ 32).
+    std::uint32_t row_pixels(std::uint32_t bits, int y, int x0, int n) const {
+        std::uint32_t out = 0;
+        for (int x = x0; bits && x < x0 + n;) {
+            const int end = std::min(x0 + n, ((x >> kBlockShift) + 1) << kBlockShift);
+            if (bits >> bit(x, y) & 1) out |= ((std::uint32_t{1} << (end - x)) - 1) << (x - x0);
+            x = end;
+        }
+        return out;
+    }
+
     /// Narrows the pixels [x0, x1) of row y to leave out skipped blocks at either end.
     void trim(std::uint32_t skipped, int y, int& x0, int& x1) const {
         if (!skipped) return;

@@ -1,0 +1,86 @@
+#include "sample_row.hpp"
+
+#include <emmintrin.h>
+
+#include <cstring>
+
+namespace mipraster {
+namespace kernels {
+
+namespace {
+
+// |x| < 2^52: every integer between two such values, and their sums with the row's steps, is a
+// double, so the sums below are exact.
+inline bool small(std::int64_t x) { return x > -(std::int64_t{1} << 52) && x < (std::int64_t{1} << 52); }
+
+}  // namespace
+
+// SSE2 (the x86-64 baseline): one code path on every CPU, two doubles per register. Each product
+// and sum is rounded on its own, as in the per-sample path (intrinsics are never contracted).
+bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested, DepthFunc func,
+                     bool depth_write, float* depth, SampleRow& out) {
+    // The per-sample path converts e_i + bias_i to double at each pixel; here the row's first value
+    // is converted once and the step added: the same integer, exactly, while it stays below 2^52.
+    __m128d base[3], step[3], bias[3];
+    for (int i = 0; i < 3; ++i) {
+        const std::int64_t first = e[i] + t.bias[i];
+        const std::int64_t stride = std::int64_t{t.edge_a[i]} * kSubpixelOne;
+        if (!small(first) || !small(first + stride * (n - 1))) return false;
+        base[i] = _mm_set1_pd(static_cast<double>(first));
+        step[i] = _mm_set1_pd(static_cast<double>(stride));
+        bias[i] = _mm_set1_pd(static_cast<double>(t.bias[i]));
+    }
+    const __m128d inv_area2 = _mm_set1_pd(t.inv_area2), z0 = _mm_set1_pd(t.z0), dz1 = _mm_set1_pd(t.dz1),
+                  dz2 = _mm_set1_pd(t.dz2);
+    const bool greater = func == DepthFunc::greater;
+    out.covered = out.passed = 0;
+    const __m128i lane_bit = _mm_set_epi32(8, 4, 2, 1);
+    for (int j = 0; j < n; j += 4) {
+        // Two pixels per half: j, j + 1 and j + 2, j + 3.
+        __m128d l0[2], l1[2], l2[2], inside[2];
+        __m128 z[2];
+        for (int h = 0; h < 2; ++h) {
+            const __m128d lane = _mm_set_pd(double(j + 2 * h + 1), double(j + 2 * h));
+            const __m128d d0 = _mm_add_pd(base[0], _mm_mul_pd(lane, step[0]));
+            const __m128d d1 = _mm_add_pd(base[1], _mm_mul_pd(lane, step[1]));
+            const __m128d d2 = _mm_add_pd(base[2], _mm_mul_pd(lane, step[2]));
+            // e_i ≥ 0 ⇔ e_i + bias_i ≥ bias_i, both exact.
+            inside[h] =
+                _mm_and_pd(_mm_and_pd(_mm_cmpge_pd(d0, bias[0]), _mm_cmpge_pd(d1, bias[1])), _mm_cmpge_pd(d2, bias[2]));
+            l0[h] = _mm_mul_pd(d0, inv_area2);  // screen_weights
+            l1[h] = _mm_mul_pd(d1, inv_area2);
+            l2[h] = _mm_mul_pd(d2, inv_area2);
+            z[h] = _mm_cvtpd_ps(_mm_add_pd(_mm_add_pd(z0, _mm_mul_pd(l1[h], dz1)), _mm_mul_pd(l2[h], dz2)));  // sample_depth
+        }
+        // The four lanes as floats: each 64-bit mask's low half, the two halves' depths side by side.
+        const __m128 covered = _mm_shuffle_ps(_mm_castpd_ps(inside[0]), _mm_castpd_ps(inside[1]), _MM_SHUFFLE(2, 0, 2, 0));
+        const __m128 depths = _mm_movelh_ps(z[0], z[1]);
+        const int lanes = n - j < 4 ? n - j : 4;
+        const std::uint32_t in_row = (1u << lanes) - 1u;
+        out.covered |= (static_cast<std::uint32_t>(_mm_movemask_ps(covered)) & in_row) << j;
+        const __m128 asked = _mm_and_ps(
+            covered, _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(tested >> j)), lane_bit), lane_bit)));
+        if (!(_mm_movemask_ps(asked) & in_row)) continue;
+        float partial[4] = {};  // the row's last, partial group
+        float* const stored = lanes == 4 ? depth + j : partial;
+        if (lanes < 4) std::memcpy(partial, depth + j, sizeof(float) * static_cast<std::size_t>(lanes));
+        const __m128 s = _mm_loadu_ps(stored);
+        const __m128 wins = _mm_and_ps(asked, greater ? _mm_cmpgt_ps(depths, s) : _mm_cmplt_ps(depths, s));
+        const std::uint32_t passed = static_cast<std::uint32_t>(_mm_movemask_ps(wins)) & in_row;
+        if (!passed) continue;
+        out.passed |= passed << j;
+        for (int h = 0; h < 2; ++h) {
+            _mm_storeu_pd(out.l0 + j + 2 * h, l0[h]);
+            _mm_storeu_pd(out.l1 + j + 2 * h, l1[h]);
+            _mm_storeu_pd(out.l2 + j + 2 * h, l2[h]);
+        }
+        if (depth_write) {
+            _mm_storeu_ps(stored, _mm_or_ps(_mm_and_ps(wins, depths), _mm_andnot_ps(wins, s)));
+            if (lanes < 4) std::memcpy(depth + j, partial, sizeof(float) * static_cast<std::size_t>(lanes));
+        }
+    }
+    return true;
+}
+
+}  // namespace kernels
+}  // namespace mipraster

@@ -1,0 +1,40 @@
+#pragma once
+// One triangle along one row of one-sample pixels (private to the pipeline): coverage, screen
+// weights and the depth test, four pixels per double vector. Each value is the tile kernel's
+// per-sample arithmetic on the same numbers in the same order (no fused multiply-add), so the
+// coverage, weights, depths and test outcomes are the per-sample path's bits.
+#include <cstdint>
+
+#include "mipraster/core/constants.hpp"
+#include "mipraster/pipeline/rasterize_tile.hpp"
+#include "mipraster/pipeline/triangle_setup.hpp"
+
+namespace mipraster {
+namespace kernels {
+
+/// Rows shorter than this take the per-sample path: a vector pass costs more than a few samples.
+inline constexpr int kSampleRowMinPixels = 8;
+
+/// What test_sample_row found along a row of n ≤ kTileSize pixels; bit j is pixel j.
+struct SampleRow {
+    std::uint32_t covered;  ///< the pixel's sample is inside the triangle
+    std::uint32_t passed;   ///< covered, asked for, and its depth test passed (depth stored if writing)
+    double l0[kTileSize], l1[kTileSize], l2[kTileSize];  ///< screen weights where passed
+};
+
+/// Triangle t over pixels j < n of a row whose first pixel's sample has edge values e (bias not
+/// added). Tests depth (less or greater) at the pixels of `tested` against depth[j], storing the
+/// passing depths when depth_write. Returns false, touching nothing, when an edge value along the
+/// row reaches 2^52 in magnitude (its sums in double could round): the per-sample path then runs.
+bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested, DepthFunc func,
+                     bool depth_write, float* depth, SampleRow& out);
+
+/// Set bits of a 32-bit mask (baseline x86-64 has no popcnt instruction; GCC would call libgcc).
+inline int count_bits(std::uint32_t m) {
+    m = m - ((m >> 1) & 0x55555555u);
+    m = (m & 0x33333333u) + ((m >> 2) & 0x33333333u);
+    return static_cast<int>((((m + (m >> 4)) & 0x0F0F0F0Fu) * 0x01010101u) >> 24);
+}
+
+}  // namespace kernels
+}  // namespace mipraster
