@@ -181,9 +181,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 if (!covered) continue;
                 const int px = rx0 + j;
                 if (classified && (classified >> blocks.bit(px, py) & 1)) {  // counted, not tested
-                    if (cls.hidden >> blocks.bit(px, py) & 1)  // (one sample: the mask is 1; baseline x86-64 has no popcnt)
-                        counters.samples_covered += kMode == SampleMode::single ? covered
-                                                                                : static_cast<std::uint64_t>(__builtin_popcountll(covered));
+                    if (cls.hidden >> blocks.bit(px, py) & 1)
+                        counters.samples_covered += static_cast<std::uint64_t>(count_bits(covered));
                     continue;
                 }
                 const std::int64_t p0 = row0 + j * step0, p1 = row1 + j * step1, p2 = row2 + j * step2;
@@ -206,7 +205,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     }
                     if (!passed) continue;
                     if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
-                    counters.samples_passed += static_cast<std::uint64_t>(__builtin_popcountll(passed));
+                    counters.samples_passed += static_cast<std::uint64_t>(count_bits(passed));
                     ++counters.shader_invocations;
                     glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
                     if constexpr (!((kShading == Shading::constant || kShading == Shading::flat) &&

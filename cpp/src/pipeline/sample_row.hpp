@@ -29,11 +29,14 @@ struct SampleRow {
 bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested, DepthFunc func,
                      bool depth_write, float* depth, SampleRow& out);
 
-/// Set bits of a 32-bit mask (baseline x86-64 has no popcnt instruction; GCC would call libgcc).
-inline int count_bits(std::uint32_t m) {
+/// Set bits of a mask (baseline x86-64 has no popcnt instruction; GCC would call libgcc).
+[[gnu::always_inline]] inline int count_bits(std::uint32_t m) {
     m = m - ((m >> 1) & 0x55555555u);
     m = (m & 0x33333333u) + ((m >> 2) & 0x33333333u);
     return static_cast<int>((((m + (m >> 4)) & 0x0F0F0F0Fu) * 0x01010101u) >> 24);
+}
+[[gnu::always_inline]] inline int count_bits(std::uint64_t m) {
+    return count_bits(static_cast<std::uint32_t>(m)) + count_bits(static_cast<std::uint32_t>(m >> 32));
 }
 
 }  // namespace kernels
