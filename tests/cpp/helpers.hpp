@@ -176,6 +176,27 @@ bool same_bits(const Floats& a, const Floats& b) {
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
 }
 
+/// The scene rendered with a switch of the settings off, then on: {off, on}.
+inline std::pair<mr::RenderResult, mr::RenderResult> render_off_on(const std::vector<mr::Draw>& draws,
+                                                                   const mr::Camera& cam, mr::RenderSettings s,
+                                                                   bool mr::RenderSettings::*flag) {
+    s.*flag = false;
+    mr::RenderResult off = mr::render(draws, cam, s);
+    s.*flag = true;
+    return {std::move(off), mr::render(draws, cam, s)};
+}
+
+/// Two renders of one scene by two paths agree bit for bit: resolved colour, samples, depth and
+/// the sample counters.
+inline void expect_same_render(const mr::RenderResult& fast, const mr::RenderResult& plain) {
+    EXPECT_TRUE(same_bits(fast.color.pixels, plain.color.pixels)) << "resolved colour differs";
+    EXPECT_TRUE(same_bits(fast.framebuffer.color, plain.framebuffer.color)) << "samples differ";
+    EXPECT_TRUE(same_bits(fast.framebuffer.depth, plain.framebuffer.depth)) << "depth differs";
+    EXPECT_EQ(fast.stats.samples_covered, plain.stats.samples_covered);
+    EXPECT_EQ(fast.stats.samples_passed, plain.stats.samples_passed);
+    EXPECT_EQ(fast.stats.shader_invocations, plain.stats.shader_invocations);
+}
+
 /// A perspective camera at (0.3, 0.8, 4) looking at the origin, for scenes of random_triangles in
 /// [−1.5, 1.5]×[−1, 1]×[−2, 6] (some cross its near plane).
 inline mr::Camera overlap_camera(mr::DepthConvention convention, int width, int height) {

@@ -57,18 +57,10 @@ TEST(BlockSkipping, SameBitsAndCountersAsThePlainPathOnRandomOverlappingScenes) 
                     s.anti_aliasing = mode.aa;
                     s.threads = threads;
                     s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
-                    s.block_skipping = false;
-                    const mr::RenderResult plain = mr::render(draws, cam, s);
-                    s.block_skipping = true;
-                    const mr::RenderResult fast = mr::render(draws, cam, s);
+                    const auto [plain, fast] = render_off_on(draws, cam, s, &mr::RenderSettings::block_skipping);
                     EXPECT_EQ(plain.stats.depth_blocks_rejected, 0u);
                     EXPECT_GT(fast.stats.depth_blocks_rejected, 0u);
-                    EXPECT_TRUE(same_bits(fast.color.pixels, plain.color.pixels)) << "resolved colour differs";
-                    EXPECT_TRUE(same_bits(fast.framebuffer.color, plain.framebuffer.color)) << "samples differ";
-                    EXPECT_TRUE(same_bits(fast.framebuffer.depth, plain.framebuffer.depth)) << "depth differs";
-                    EXPECT_EQ(fast.stats.samples_covered, plain.stats.samples_covered);
-                    EXPECT_EQ(fast.stats.samples_passed, plain.stats.samples_passed);
-                    EXPECT_EQ(fast.stats.shader_invocations, plain.stats.shader_invocations);
+                    expect_same_render(fast, plain);
                 }
         }
     }
@@ -116,16 +108,10 @@ TEST(BlockSkipping, ATriangleOverAWholeTileIsTestedAgainstEveryBlockOfIt) {
                 const std::vector<mr::Draw> draws = {make_draw(occluders, glm::dmat4(1.0), {}),
                                                      make_draw(walls, glm::dmat4(1.0), {})};
                 const mr::Camera cam = overlap_camera(convention, W, H);
-                auto s = settings(W, H, samples);
-                s.block_skipping = false;
-                const mr::RenderResult plain = mr::render(draws, cam, s);
-                s.block_skipping = true;
-                const mr::RenderResult fast = mr::render(draws, cam, s);
+                const auto [plain, fast] =
+                    render_off_on(draws, cam, settings(W, H, samples), &mr::RenderSettings::block_skipping);
                 EXPECT_GT(fast.stats.depth_blocks_rejected, 0u);
-                EXPECT_TRUE(same_bits(fast.framebuffer.color, plain.framebuffer.color)) << "samples differ";
-                EXPECT_TRUE(same_bits(fast.framebuffer.depth, plain.framebuffer.depth)) << "depth differs";
-                EXPECT_EQ(fast.stats.samples_covered, plain.stats.samples_covered);
-                EXPECT_EQ(fast.stats.samples_passed, plain.stats.samples_passed);
+                expect_same_render(fast, plain);
             }
 }
 

@@ -17,18 +17,11 @@ namespace {
 namespace mr = mipraster;
 using namespace helpers;
 
-void expect_same_with_and_without_rows(const std::vector<mr::Draw>& draws, const mr::Camera& cam, mr::RenderSettings s) {
-    s.sample_rows = false;
-    const mr::RenderResult plain = mr::render(draws, cam, s);
-    s.sample_rows = true;
-    const mr::RenderResult rows = mr::render(draws, cam, s);
+void expect_same_with_and_without_rows(const std::vector<mr::Draw>& draws, const mr::Camera& cam,
+                                       const mr::RenderSettings& s) {
+    const auto [plain, rows] = render_off_on(draws, cam, s, &mr::RenderSettings::sample_rows);
     EXPECT_GT(rows.stats.samples_passed, 0u);
-    EXPECT_TRUE(same_bits(rows.color.pixels, plain.color.pixels)) << "resolved colour differs";
-    EXPECT_TRUE(same_bits(rows.framebuffer.color, plain.framebuffer.color)) << "samples differ";
-    EXPECT_TRUE(same_bits(rows.framebuffer.depth, plain.framebuffer.depth)) << "depth differs";
-    EXPECT_EQ(rows.stats.samples_covered, plain.stats.samples_covered);
-    EXPECT_EQ(rows.stats.samples_passed, plain.stats.samples_passed);
-    EXPECT_EQ(rows.stats.shader_invocations, plain.stats.shader_invocations);
+    expect_same_render(rows, plain);
     EXPECT_EQ(rows.stats.depth_blocks_rejected, plain.stats.depth_blocks_rejected);
     EXPECT_EQ(rows.stats.tiles_deferred, plain.stats.tiles_deferred);
 }

@@ -182,7 +182,8 @@ private:
     }
 
     // When t covers no sample of the target, or covers all and all fail the depth test: every
-    // block skipped (what the blocks one by one would give, counters included), and true.
+    // block skipped, and true. The samples are counted as the blocks one by one would count them
+    // (depth_rejected also counts blocks too thin to classify one by one, at a viewport's edge).
     template <DepthFunc kDepth>
     bool whole_target(const SetupTriangle& t, int S, BlockClasses& out) {
         const SampleExtent r = extent(target_.x0, target_.y0, target_.x1, target_.y1);
@@ -195,11 +196,10 @@ private:
         else {
             if (coverage != BlockCoverage::all) return false;
             const std::uint32_t blocks = blocks_in(target_.x0, target_.y0, target_.x1, target_.y1);
-            float farthest = 0.0f;
+            float farthest = 0.0f;  // over every block of the target
             for (std::uint32_t m = blocks; m; m &= m - 1) {
-                const std::uint32_t b = std::uint32_t{1} << __builtin_ctz(m);
-                known_farthest<kDepth>(b);
-                const float f = farthest_[__builtin_ctz(b)];
+                known_farthest<kDepth>(m & -m);
+                const float f = farthest_[__builtin_ctz(m)];
                 if (m == blocks || (kDepth == DepthFunc::greater ? f < farthest : f > farthest)) farthest = f;
             }
             const float nearest = nearest_depth<kDepth>(t, r);
