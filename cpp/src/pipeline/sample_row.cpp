@@ -2,8 +2,6 @@
 
 #include <emmintrin.h>
 
-#include <cstring>
-
 namespace mipraster {
 namespace kernels {
 
@@ -61,10 +59,11 @@ bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, 
         const __m128 asked = _mm_and_ps(
             covered, _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(tested >> j)), lane_bit), lane_bit)));
         if (!(_mm_movemask_ps(asked) & in_row)) continue;
-        float partial[4] = {};  // the row's last, partial group
-        float* const stored = lanes == 4 ? depth + j : partial;
-        if (lanes < 4) std::memcpy(partial, depth + j, sizeof(float) * static_cast<std::size_t>(lanes));
-        const __m128 s = _mm_loadu_ps(stored);
+        // The row's last group may be short: built in registers (scalar stores then a vector load
+        // would wait for store forwarding).
+        float* const stored = depth + j;
+        const __m128 s = lanes == 4 ? _mm_loadu_ps(stored)
+                                    : _mm_setr_ps(stored[0], lanes > 1 ? stored[1] : 0.0f, lanes > 2 ? stored[2] : 0.0f, 0.0f);
         const __m128 wins = _mm_and_ps(asked, greater ? _mm_cmpgt_ps(depths, s) : _mm_cmplt_ps(depths, s));
         const std::uint32_t passed = static_cast<std::uint32_t>(_mm_movemask_ps(wins)) & in_row;
         if (!passed) continue;
@@ -74,9 +73,12 @@ bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, 
             _mm_storeu_pd(out.l1 + j + 2 * h, l1[h]);
             _mm_storeu_pd(out.l2 + j + 2 * h, l2[h]);
         }
-        if (depth_write) {
+        if (depth_write && lanes == 4) {
             _mm_storeu_ps(stored, _mm_or_ps(_mm_and_ps(wins, depths), _mm_andnot_ps(wins, s)));
-            if (lanes < 4) std::memcpy(depth + j, partial, sizeof(float) * static_cast<std::size_t>(lanes));
+        } else if (depth_write) {
+            if (passed & 1) stored[0] = _mm_cvtss_f32(depths);
+            if (passed & 2) stored[1] = _mm_cvtss_f32(_mm_shuffle_ps(depths, depths, 1));
+            if (passed & 4) stored[2] = _mm_cvtss_f32(_mm_shuffle_ps(depths, depths, 2));
         }
     }
     return true;
