@@ -265,37 +265,66 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
     TriangleUvs uvs{};
     std::optional<LookupQueue<BlendMode::replace, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
-    for (int py = target.y0; py < target.y1; ++py)
-        for (int px = target.x0; px < target.x1; ++px) {
-            float* const color_px = target.color.at(px, py, 0);
-            for (int s = 0; s < S; ++s) {
-                const std::int32_t owner = target.owners[target.owner_index(px, py, s, S)];
-                if (owner < 0) continue;
-                if (owner != cached) {
-                    const OwnerRef& next = refs[static_cast<std::size_t>(owner)];
-                    if (next.triangle->draw != draw_index) continue;
-                    cached = owner;
-                    ref = next;
-                    const glm::uvec3 tri = draw.triangles[ref.triangle->triangle];
-                    if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective)
-                        colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
-                    if constexpr (kTexturing != Texturing::none) {
-                        uvs = TriangleUvs(*ref.triangle, tri, draw.uvs, ref.clip_weights);
-                        if (queue) queue->begin_triangle(*ref.triangle, colors, uvs, ref.clip_weights);
-                    }
+    // Makes `owner` the current triangle if it is one of this draw's (false: another draw's).
+    const auto take = [&](std::int32_t owner) {
+        if (owner == cached) return true;
+        const OwnerRef& next = refs[static_cast<std::size_t>(owner)];
+        if (next.triangle->draw != draw_index) return false;
+        cached = owner;
+        ref = next;
+        const glm::uvec3 tri = draw.triangles[ref.triangle->triangle];
+        if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective)
+            colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
+        if constexpr (kTexturing != Texturing::none) {
+            uvs = TriangleUvs(*ref.triangle, tri, draw.uvs, ref.clip_weights);
+            if (queue) queue->begin_triangle(*ref.triangle, colors, uvs, ref.clip_weights);
+        }
+        return true;
+    };
+    // The current triangle's edge values at sample s of pixel (px, py).
+    const auto edges_at = [&](int px, int py, int s, std::int64_t (&e)[3]) {
+        const SetupTriangle& t = *ref.triangle;
+        const std::int64_t X = std::int64_t{px} * kSubpixelOne + pattern.x[s];
+        const std::int64_t Y = std::int64_t{py} * kSubpixelOne + pattern.y[s];
+        for (int i = 0; i < 3; ++i) e[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+    };
+    const auto shade_sample = [&](int px, int py, int s, const glm::dvec3& l) __attribute__((always_inline)) {
+        ++counters.shader_invocations;
+        shade_into<BlendMode::replace, kShading, kTexturing>(queue ? &*queue : nullptr, target.color.at(px, py, s),
+                                                             std::uint64_t{1}, draw, colors, uvs, *ref.triangle, l,
+                                                             ref.clip_weights, px, py);
+    };
+    const auto shade_exactly = [&](int px, int py, int s) {
+        std::int64_t e[3];
+        edges_at(px, py, s, e);
+        shade_sample(px, py, s, screen_weights(*ref.triangle, e[0], e[1], e[2]));
+    };
+    if (S == 1) {
+        // Runs of pixels with one owner, their weights a row at a time (sample_row.hpp).
+        double l0[kTileSize], l1[kTileSize], l2[kTileSize];
+        for (int py = target.y0; py < target.y1; ++py) {
+            const std::int32_t* const row = &target.owners[target.owner_index(target.x0, py, 0, 1)] - target.x0;
+            for (int px = target.x0, end; px < target.x1; px = end) {
+                const std::int32_t owner = row[px];
+                for (end = px + 1; end < target.x1 && row[end] == owner;) ++end;
+                if (owner < 0 || !take(owner)) continue;
+                std::int64_t e[3];
+                edges_at(px, py, 0, e);
+                if (end - px >= kSampleRowMinPixels && sample_row_weights(*ref.triangle, e, end - px, l0, l1, l2)) {
+                    for (int j = 0; j < end - px; ++j) shade_sample(px + j, py, 0, glm::dvec3(l0[j], l1[j], l2[j]));
+                } else {
+                    for (int x = px; x < end; ++x) shade_exactly(x, py, 0);
                 }
-                const SetupTriangle& t = *ref.triangle;
-                const std::int64_t X = std::int64_t{px} * kSubpixelOne + pattern.x[s];
-                const std::int64_t Y = std::int64_t{py} * kSubpixelOne + pattern.y[s];
-                const glm::dvec3 l = screen_weights(t, t.edge_a[0] * X + t.edge_b[0] * Y + t.edge_c[0],
-                                                    t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1],
-                                                    t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2]);
-                ++counters.shader_invocations;
-                shade_into<BlendMode::replace, kShading, kTexturing>(queue ? &*queue : nullptr, color_px,
-                                                                     std::uint64_t{1} << s, draw, colors, uvs, t, l,
-                                                                     ref.clip_weights, px, py);
             }
         }
+    } else {
+        for (int py = target.y0; py < target.y1; ++py)
+            for (int px = target.x0; px < target.x1; ++px)
+                for (int s = 0; s < S; ++s) {
+                    const std::int32_t owner = target.owners[target.owner_index(px, py, s, S)];
+                    if (owner >= 0 && take(owner)) shade_exactly(px, py, s);
+                }
+    }
     if (queue) queue->flush();
 }
 

@@ -11,6 +11,15 @@ namespace {
 // double, so the sums below are exact.
 inline bool small(std::int64_t x) { return x > -(std::int64_t{1} << 52) && x < (std::int64_t{1} << 52); }
 
+// Whether e_i + bias_i stays below 2^52 in magnitude along the n pixels of the row.
+bool exact_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n) {
+    for (int i = 0; i < 3; ++i) {
+        const std::int64_t first = e[i] + t.bias[i];
+        if (!small(first) || !small(first + std::int64_t{t.edge_a[i]} * kSubpixelOne * (n - 1))) return false;
+    }
+    return true;
+}
+
 }  // namespace
 
 // SSE2 (the x86-64 baseline): one code path on every CPU, two doubles per register. Each product
@@ -19,13 +28,11 @@ bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, 
                      bool depth_write, float* depth, SampleRow& out) {
     // The per-sample path converts e_i + bias_i to double at each pixel; here the row's first value
     // is converted once and the step added: the same integer, exactly, while it stays below 2^52.
+    if (!exact_row(t, e, n)) return false;
     __m128d base[3], step[3], bias[3];
     for (int i = 0; i < 3; ++i) {
-        const std::int64_t first = e[i] + t.bias[i];
-        const std::int64_t stride = std::int64_t{t.edge_a[i]} * kSubpixelOne;
-        if (!small(first) || !small(first + stride * (n - 1))) return false;
-        base[i] = _mm_set1_pd(static_cast<double>(first));
-        step[i] = _mm_set1_pd(static_cast<double>(stride));
+        base[i] = _mm_set1_pd(static_cast<double>(e[i] + t.bias[i]));
+        step[i] = _mm_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
         bias[i] = _mm_set1_pd(static_cast<double>(t.bias[i]));
     }
     const __m128d inv_area2 = _mm_set1_pd(t.inv_area2), z0 = _mm_set1_pd(t.z0), dz1 = _mm_set1_pd(t.dz1),
@@ -79,6 +86,21 @@ bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, 
             if (passed & 1) stored[0] = _mm_cvtss_f32(depths);
             if (passed & 2) stored[1] = _mm_cvtss_f32(_mm_shuffle_ps(depths, depths, 1));
             if (passed & 4) stored[2] = _mm_cvtss_f32(_mm_shuffle_ps(depths, depths, 2));
+        }
+    }
+    return true;
+}
+
+bool sample_row_weights(const SetupTriangle& t, const std::int64_t (&e)[3], int n, double* l0, double* l1, double* l2) {
+    if (!exact_row(t, e, n)) return false;
+    double* const out[3] = {l0, l1, l2};
+    const __m128d inv_area2 = _mm_set1_pd(t.inv_area2);
+    for (int i = 0; i < 3; ++i) {
+        const __m128d base = _mm_set1_pd(static_cast<double>(e[i] + t.bias[i]));
+        const __m128d step = _mm_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
+        for (int j = 0; j < n; j += 2) {
+            const __m128d lane = _mm_set_pd(double(j + 1), double(j));
+            _mm_storeu_pd(out[i] + j, _mm_mul_pd(_mm_add_pd(base, _mm_mul_pd(lane, step)), inv_area2));
         }
     }
     return true;

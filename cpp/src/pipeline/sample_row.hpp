@@ -29,6 +29,11 @@ struct SampleRow {
 bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested, DepthFunc func,
                      bool depth_write, float* depth, SampleRow& out);
 
+/// The screen weights of pixels j < n of a row whose first pixel's sample has edge values e (bias
+/// not added), into l_i[j] (room for n rounded up to even): screen_weights' bits. False, touching
+/// nothing, where test_sample_row would be.
+bool sample_row_weights(const SetupTriangle& t, const std::int64_t (&e)[3], int n, double* l0, double* l1, double* l2);
+
 /// Set bits of a mask (baseline x86-64 has no popcnt instruction; GCC would call libgcc).
 [[gnu::always_inline]] inline int count_bits(std::uint32_t m) {
     m = m - ((m >> 1) & 0x55555555u);
