@@ -20,21 +20,33 @@ bool exact_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n) {
     return true;
 }
 
+// The row's edge values plus bias, e_i + bias_i + j·step_i at pixel j, two pixels per register:
+// the per-sample path converts each to double; here the first is converted once and the steps
+// added, the same integers exactly while exact_row holds.
+struct RowEdges {
+    __m128d first[3], step[3];
+    RowEdges(const SetupTriangle& t, const std::int64_t (&e)[3]) {
+        for (int i = 0; i < 3; ++i) {
+            first[i] = _mm_set1_pd(static_cast<double>(e[i] + t.bias[i]));
+            step[i] = _mm_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
+        }
+    }
+    // Edge i at pixels j and j + 1.
+    __m128d at(int i, int j) const {
+        return _mm_add_pd(first[i], _mm_mul_pd(_mm_set_pd(double(j + 1), double(j)), step[i]));
+    }
+};
+
 }  // namespace
 
 // SSE2 (the x86-64 baseline): one code path on every CPU, two doubles per register. Each product
 // and sum is rounded on its own, as in the per-sample path (intrinsics are never contracted).
 bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested, DepthFunc func,
                      bool depth_write, float* depth, SampleRow& out) {
-    // The per-sample path converts e_i + bias_i to double at each pixel; here the row's first value
-    // is converted once and the step added: the same integer, exactly, while it stays below 2^52.
     if (!exact_row(t, e, n)) return false;
-    __m128d base[3], step[3], bias[3];
-    for (int i = 0; i < 3; ++i) {
-        base[i] = _mm_set1_pd(static_cast<double>(e[i] + t.bias[i]));
-        step[i] = _mm_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
-        bias[i] = _mm_set1_pd(static_cast<double>(t.bias[i]));
-    }
+    const RowEdges edges(t, e);
+    __m128d bias[3];
+    for (int i = 0; i < 3; ++i) bias[i] = _mm_set1_pd(static_cast<double>(t.bias[i]));
     const __m128d inv_area2 = _mm_set1_pd(t.inv_area2), z0 = _mm_set1_pd(t.z0), dz1 = _mm_set1_pd(t.dz1),
                   dz2 = _mm_set1_pd(t.dz2);
     const bool greater = func == DepthFunc::greater;
@@ -45,10 +57,7 @@ bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, 
         __m128d l0[2], l1[2], l2[2], inside[2];
         __m128 z[2];
         for (int h = 0; h < 2; ++h) {
-            const __m128d lane = _mm_set_pd(double(j + 2 * h + 1), double(j + 2 * h));
-            const __m128d d0 = _mm_add_pd(base[0], _mm_mul_pd(lane, step[0]));
-            const __m128d d1 = _mm_add_pd(base[1], _mm_mul_pd(lane, step[1]));
-            const __m128d d2 = _mm_add_pd(base[2], _mm_mul_pd(lane, step[2]));
+            const __m128d d0 = edges.at(0, j + 2 * h), d1 = edges.at(1, j + 2 * h), d2 = edges.at(2, j + 2 * h);
             // e_i ≥ 0 ⇔ e_i + bias_i ≥ bias_i, both exact.
             inside[h] =
                 _mm_and_pd(_mm_and_pd(_mm_cmpge_pd(d0, bias[0]), _mm_cmpge_pd(d1, bias[1])), _mm_cmpge_pd(d2, bias[2]));
@@ -93,16 +102,11 @@ bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, 
 
 bool sample_row_weights(const SetupTriangle& t, const std::int64_t (&e)[3], int n, double* l0, double* l1, double* l2) {
     if (!exact_row(t, e, n)) return false;
+    const RowEdges edges(t, e);
     double* const out[3] = {l0, l1, l2};
     const __m128d inv_area2 = _mm_set1_pd(t.inv_area2);
-    for (int i = 0; i < 3; ++i) {
-        const __m128d base = _mm_set1_pd(static_cast<double>(e[i] + t.bias[i]));
-        const __m128d step = _mm_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
-        for (int j = 0; j < n; j += 2) {
-            const __m128d lane = _mm_set_pd(double(j + 1), double(j));
-            _mm_storeu_pd(out[i] + j, _mm_mul_pd(_mm_add_pd(base, _mm_mul_pd(lane, step)), inv_area2));
-        }
-    }
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < n; j += 2) _mm_storeu_pd(out[i] + j, _mm_mul_pd(edges.at(i, j), inv_area2));
     return true;
 }
 
