@@ -46,7 +46,8 @@ void ThreadPool::run_tasks(std::unique_lock<std::mutex>& lock) {
         lock.lock();
         if (failure && !error_) {
             error_ = failure;
-            next_ = count_;  // stop handing out work
+            finished_ += count_ - next_;  // the tasks not handed out will not run: done with them too
+            next_ = count_;               // (stop handing out work)
         }
         ++finished_;
     }
