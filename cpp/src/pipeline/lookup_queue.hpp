@@ -39,10 +39,17 @@ public:
     /// Queues the shade of samples `samples` (a bit mask) at 4-float colour slots of `target`:
     /// the current triangle at screen weights l of pixel (px, py).
     void push(float* target, std::uint64_t samples, const glm::dvec3& l, int px, int py) {
-        weights_.l0[count_] = l.x, weights_.l1[count_] = l.y, weights_.l2[count_] = l.z;
-        pending_[count_] = {target, samples, current_, px, py};
-        current_queued_ = true;
-        if (++count_ == kLookupBatch) flush();
+        enqueue(target, samples, l.x, l.y, l.z, px, py);
+    }
+
+    /// push for the one-sample pixels of a row, in order: bit j of `pixels` is pixel (x0 + j, y),
+    /// its colour slot at row_target + 4j and its screen weights l0[j], l1[j], l2[j].
+    void push_row(float* row_target, std::uint32_t pixels, const double* l0, const double* l1, const double* l2, int x0,
+                  int y) {
+        for (; pixels; pixels &= pixels - 1) {
+            const int j = __builtin_ctz(pixels);
+            enqueue(row_target + 4 * j, 1, l0[j], l1[j], l2[j], x0 + j, y);
+        }
     }
 
     /// Shades and blends what is queued (also before the kernel returns).
@@ -80,6 +87,13 @@ public:
     }
 
 private:
+    void enqueue(float* target, std::uint64_t samples, double l0, double l1, double l2, int px, int py) {
+        weights_.l0[count_] = l0, weights_.l1[count_] = l1, weights_.l2[count_] = l2;
+        pending_[count_] = {target, samples, current_, px, py};
+        current_queued_ = true;
+        if (++count_ == kLookupBatch) flush();
+    }
+
     struct Triangle {
         const SetupTriangle* t;
         const ClipWeights* clip_weights;

@@ -128,6 +128,27 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
         };
 
+        // The passed pixels of a one-sample row (bit j: pixel rx0 + j) at once, as passed_sample takes
+        // them one by one: for queued lookups and the deferred pre-pass's owners (false: neither).
+        const auto passed_row = [&](int rx0, int py, const SampleRow& row) {
+            if constexpr (kShading == Shading::visibility) {
+                if (!target.owners) return false;
+            } else if (!queue) {
+                return false;
+            }
+            if constexpr (kDepth != DepthFunc::none) blocks.written_row(py, rx0, row.passed);
+            const auto passed = static_cast<std::uint64_t>(count_bits(row.passed));
+            counters.samples_passed += passed;
+            if constexpr (kShading == Shading::visibility) {
+                std::int32_t* const owners = target.owners + target.owner_index(rx0, py, 0, 1);
+                for (std::uint32_t m = row.passed; m; m &= m - 1) owners[__builtin_ctz(m)] = owner;
+            } else {
+                counters.shader_invocations += passed;
+                queue->push_row(color_out.at(rx0, py, 0), row.passed, row.l0, row.l1, row.l2, rx0, py);
+            }
+            return true;
+        };
+
         for (int py = y0; py < y1; ++py) {
             int rx0 = x0, rx1 = x1;  // the row without skipped blocks at its ends
             blocks.trim(cls.skipped, py, rx0, rx1);
@@ -148,6 +169,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     SampleRow row;
                     if (test_sample_row(t, e, n, ~untested, kDepth, draw.depth_write, depth_out.at(rx0, py, 0), row)) {
                         counters.samples_covered += static_cast<std::uint64_t>(count_bits(row.covered & ~skipped));
+                        if constexpr (kShading == Shading::visibility || kTexturing != Texturing::none)
+                            if (passed_row(rx0, py, row)) continue;
                         for (std::uint32_t m = row.passed; m; m &= m - 1) {
                             const int j = __builtin_ctz(m);
                             passed_sample(rx0 + j, py, 0, glm::dvec3(row.l0[j], row.l1[j], row.l2[j]));

@@ -108,6 +108,15 @@ public:
     int bit(int x, int y) const { return ((y >> kBlockShift) - by0_) * kBlocksPerSide + (x >> kBlockShift) - bx0_; }
     /// After a depth write at pixel (x, y).
     void written(int x, int y) { known_ &= ~(std::uint32_t{1} << bit(x, y)); }
+    /// After depth writes at the pixels x0 + j of row y, bit j of `pixels` (j < kTileSize): once per block.
+    void written_row(int y, int x0, std::uint32_t pixels) {
+        while (pixels) {
+            const int x = x0 + __builtin_ctz(pixels);
+            written(x, y);
+            const int next_block = (((x >> kBlockShift) + 1) << kBlockShift) - x0;  // its first bit
+            pixels = next_block >= 32 ? 0 : pixels & (~std::uint32_t{0} << next_block);  // (no shift by 32)
+        }
+    }
 
     /// The bits of the blocks that hold pixels of [x0, x1) × [y0, y1) (inside the target).
     std::uint32_t blocks_in(int x0, int y0, int x1, int y1) const {
