@@ -1,6 +1,6 @@
 // The thread pool (thread_pool.hpp): every index of every parallel_for runs exactly once and is
-// finished when the call returns, whether the workers were still watching for work or had gone to
-// sleep; a task's exception reaches the caller and leaves the pool usable; pools are leased again.
+// finished when the call returns, for calls back to back and after the workers have gone to sleep;
+// a task's exception reaches the caller and leaves the pool usable; pools are leased again.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -32,13 +32,13 @@ void expect_each_index_once(mr::ThreadPool& pool, int calls, std::chrono::micros
     }
 }
 
-TEST(ThreadPool, EveryIndexRunsOnceWhetherWorkersWatchOrSleep) {
+TEST(ThreadPool, EveryIndexRunsOnceInCallsBackToBackAndAfterSleeps) {
     for (int threads : {1, 2, 3, 8}) {
         SCOPED_TRACE(threads);
         mr::ThreadPool pool(threads);
         EXPECT_EQ(pool.size(), threads);
-        expect_each_index_once(pool, 300, std::chrono::microseconds(0));     // workers still watching
-        expect_each_index_once(pool, 20, std::chrono::microseconds(3000));  // workers asleep in between
+        expect_each_index_once(pool, 300, std::chrono::microseconds(0));     // back to back
+        expect_each_index_once(pool, 20, std::chrono::microseconds(3000));  // workers asleep between
     }
 }
 
