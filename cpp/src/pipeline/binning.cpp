@@ -78,11 +78,11 @@ double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1)
     return double(bx1 - bx0) * double(by1 - by0) * fill;
 }
 
-void bin_triangles(BinnedChunk& chunk, const TileGrid& grid) {
+void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas) {
     // Pass 1 counts the entries of each tile (and adds up the area each triangle covers of it),
     // pass 2 places triangle indices in order.
     chunk.tile_start.assign(static_cast<std::size_t>(grid.count()) + 1, 0);
-    chunk.tile_area.assign(static_cast<std::size_t>(grid.count()), 0.0);
+    chunk.tile_area.assign(overlap_areas ? static_cast<std::size_t>(grid.count()) : 0, 0.0);
     auto for_each_tile = [&](const SetupTriangle& t, auto&& visit) {
         for (int ty = t.min_y / kTileSize; ty <= t.max_y / kTileSize; ++ty)
             for (int tx = t.min_x / kTileSize; tx <= t.max_x / kTileSize; ++tx) visit(ty * grid.tiles_x + tx, tx, ty);
@@ -90,6 +90,7 @@ void bin_triangles(BinnedChunk& chunk, const TileGrid& grid) {
     for (const SetupTriangle& t : chunk.triangles)
         for_each_tile(t, [&](int tile, int tx, int ty) {
             ++chunk.tile_start[static_cast<std::size_t>(tile) + 1];
+            if (!overlap_areas) return;
             const int x0 = tx * kTileSize, y0 = ty * kTileSize;
             chunk.tile_area[static_cast<std::size_t>(tile)] += tile_overlap_area(
                 t, x0, y0, std::min(x0 + kTileSize, grid.width), std::min(y0 + kTileSize, grid.height));

@@ -121,8 +121,8 @@ void resolve_view_depth(const SampleWindow& depth, int x0, int y0, int x1, int y
 
 // Clip and set up one chunk of triangles, then bin them.
 void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices,
-                 const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid, BinnedChunk& chunk,
-                 SetupCounters& counters, std::uint64_t& clipped) {
+                 const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid, bool overlap_areas,
+                 BinnedChunk& chunk, SetupCounters& counters, std::uint64_t& clipped) {
     reserve_on_huge_pages(chunk.triangles, range.last - range.first);
     SetupTriangle st;
     ClipPolygon polygon;
@@ -176,14 +176,15 @@ void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices,
             }
         }
     }
-    bin_triangles(chunk, grid);
+    bin_triangles(chunk, grid, overlap_areas);
 }
 
 // Stage 2: clip, set up and bin every draw's triangles, in parallel over chunks of consecutive
-// triangles; adds the triangle counts to `stats`.
+// triangles (with each tile's overlap estimate when `overlap_areas`); adds the triangle counts to
+// `stats`.
 std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geometry, const ClipVolume& volume,
-                                       const Viewport& viewport, const TileGrid& grid, ThreadPool& pool,
-                                       RenderStats& stats) {
+                                       const Viewport& viewport, const TileGrid& grid, bool overlap_areas,
+                                       ThreadPool& pool, RenderStats& stats) {
     std::vector<ChunkRange> ranges;
     for (std::uint32_t d = 0; d < geometry.size(); ++d) {
         const std::size_t n = geometry[d].triangles->size();
@@ -196,8 +197,8 @@ std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geo
     std::vector<SetupCounters> setup_counters(ranges.size());
     std::vector<std::uint64_t> clipped(ranges.size(), 0);
     pool.parallel_for(ranges.size(), [&](std::size_t i) {
-        setup_chunk(ranges[i], geometry[ranges[i].draw], volume, viewport, grid, chunks[i], setup_counters[i],
-                    clipped[i]);
+        setup_chunk(ranges[i], geometry[ranges[i].draw], volume, viewport, grid, overlap_areas, chunks[i],
+                    setup_counters[i], clipped[i]);
     });
     for (std::size_t i = 0; i < ranges.size(); ++i) {
         stats.triangles_clipped += clipped[i];
@@ -408,32 +409,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     }
     stats.transform_ms = ms_since(t0);
 
-    // Stage 2: clip, set up and bin.
-    t0 = Clock::now();
-    const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
-    const Viewport viewport{settings.width, settings.height, camera.depth_convention};
-    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, pool, stats);
-    stats.setup_ms = ms_since(t0);
-
-    // Stage 3: per tile, one task each: clear, rasterize (shade, depth test, blend) the tile's
-    // triangles in submission order, and resolve. The samples live in a tile-local buffer that
-    // stays in cache; a whole-frame sample buffer exists only when the caller keeps the samples,
-    // and at one sample per pixel the colour goes straight into the image (no resolve at all).
-    t0 = Clock::now();
-    const int S = settings.samples;
-    const float clear_depth = camera.depth_convention == DepthConvention::opengl ? 1.0f : 0.0f;
-    const glm::vec4 clear_depth4(clear_depth);
-    // A wide resolve filter reads neighbouring pixels (across tiles): it needs every sample kept.
-    const bool wide_resolve = settings.resolve_filter != ResolveFilter::box && S > 1;
-    const bool whole_frame = settings.keep_samples || wide_resolve;
-    Framebuffer kept;
-    if (whole_frame)
-        kept = make_framebuffer(settings.width, settings.height, S, settings.clear_color, needs_depth, clear_depth);
-    // Unfilled: every tile writes each of its pixels (a clear, a resolve, or the listed-pixels
-    // clear), so a zeroing pass over the whole image first would only add a serial write.
-    result.color = Image::unfilled(settings.width, settings.height, 4);
-    if (depth_output) result.depth = Image(settings.width, settings.height, 1);
-    if (settings.estimate_error) result.error_map = Image(settings.width, settings.height, 1);
+    // Each draw's kernels (which also say whether deferred shading may run) and inputs.
     std::vector<TileKernel> kernels(draws.size()), prepass_kernels(draws.size());
     std::vector<OwnedShadingKernel> shading_kernels(draws.size());
     bool deferred = settings.deferred_shading;  // every draw has a deferred shading pass
@@ -462,10 +438,38 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             inputs[d].derivatives = settings.derivatives;
             inputs[d].debug_view = settings.debug_view;
             inputs[d].batched_lookups = settings.batched_lookups;
-            if (settings.anti_aliasing == AntiAliasing::ssaa && S > 1)
+            if (settings.anti_aliasing == AntiAliasing::ssaa && settings.samples > 1)
                 inputs[d].footprint_scale = glm::dvec2(1.0 / result.pattern.columns, 1.0 / result.pattern.rows);
         }
     }
+
+    // Stage 2: clip, set up and bin (with the per-tile overlap estimate only where a tile may be
+    // deferred).
+    t0 = Clock::now();
+    const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
+    const Viewport viewport{settings.width, settings.height, camera.depth_convention};
+    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, deferred, pool, stats);
+    stats.setup_ms = ms_since(t0);
+
+    // Stage 3: per tile, one task each: clear, rasterize (shade, depth test, blend) the tile's
+    // triangles in submission order, and resolve. The samples live in a tile-local buffer that
+    // stays in cache; a whole-frame sample buffer exists only when the caller keeps the samples,
+    // and at one sample per pixel the colour goes straight into the image (no resolve at all).
+    t0 = Clock::now();
+    const int S = settings.samples;
+    const float clear_depth = camera.depth_convention == DepthConvention::opengl ? 1.0f : 0.0f;
+    const glm::vec4 clear_depth4(clear_depth);
+    // A wide resolve filter reads neighbouring pixels (across tiles): it needs every sample kept.
+    const bool wide_resolve = settings.resolve_filter != ResolveFilter::box && S > 1;
+    const bool whole_frame = settings.keep_samples || wide_resolve;
+    Framebuffer kept;
+    if (whole_frame)
+        kept = make_framebuffer(settings.width, settings.height, S, settings.clear_color, needs_depth, clear_depth);
+    // Unfilled: every tile writes each of its pixels (a clear, a resolve, or the listed-pixels
+    // clear), so a zeroing pass over the whole image first would only add a serial write.
+    result.color = Image::unfilled(settings.width, settings.height, 4);
+    if (depth_output) result.depth = Image(settings.width, settings.height, 1);
+    if (settings.estimate_error) result.error_map = Image(settings.width, settings.height, 1);
     const std::vector<std::vector<PixelSpan>> spans = pixel_spans(settings.pixels, grid);
     const bool listed = !settings.pixels.empty();
     std::vector<TileCounters> tile_counters(static_cast<std::size_t>(grid.count()));
@@ -603,7 +607,7 @@ Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::v
     t0 = Clock::now();
     const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
     const Viewport viewport{settings.width, settings.height, settings.depth_convention};
-    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, pool, stats);
+    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, false, pool, stats);
     stats.setup_ms = ms_since(t0);
 
     // Stage 3: every tile records the nearest triangle of each sample.

@@ -27,7 +27,7 @@ struct BinnedChunk {
     std::vector<std::uint32_t> tile_start;
     RecycledVector<std::uint32_t> tile_triangles;
     /// Per tile, about how many pixels of it the chunk's triangles cover, overlaps counted again
-    /// (tile_overlap_area): what deciding on deferred shading sums.
+    /// (tile_overlap_area): what deciding on deferred shading sums. Empty when not asked for.
     std::vector<double> tile_area;
 };
 
@@ -38,7 +38,8 @@ struct BinnedChunk {
 double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1);
 
 /// Fills chunk.tile_start / tile_triangles from chunk.triangles' pixel bounds (a counting sort),
-/// and chunk.tile_area while each triangle is at hand.
-void bin_triangles(BinnedChunk& chunk, const TileGrid& grid);
+/// and, when `overlap_areas` (a render that may defer shading), chunk.tile_area while each
+/// triangle is at hand.
+void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas);
 
 }  // namespace mipraster
