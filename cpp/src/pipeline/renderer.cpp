@@ -35,25 +35,40 @@ struct ChunkRange {
     std::uint32_t draw, first, last;
 };
 
-// One draw's triangles with its vertices in clip space and the clip volume's outcode of each
-// vertex (kNonFinite marks a NaN or infinite coordinate, e.g. from a degenerate matrix): the input
-// of clipping, setup and binning, whether it came from a camera (render) or not (rasterize).
+// One draw's triangles with its vertices in clip space, the clip volume's outcode of each vertex
+// (kNonFinite marks a NaN or infinite coordinate, e.g. from a degenerate matrix) and the screen
+// position of each vertex inside the volume: the input of clipping, setup and binning, whether it
+// came from a camera (render) or not (rasterize).
 struct ClipSpaceGeometry {
     RecycledVector<glm::dvec4> positions;
     std::vector<std::uint8_t> outcodes;
+    RecycledVector<ScreenVertex> screen;  // (left default where the outcode is not 0)
     const std::vector<glm::uvec3>* triangles = nullptr;
     CullMode cull = CullMode::none;
 };
 constexpr std::uint8_t kNonFinite = 0x80;
 static_assert(kClipPlaneCount < 8, "kNonFinite must not collide with a plane bit");
 
-// Outcodes of positions [lo, hi).
-void compute_outcodes(ClipSpaceGeometry& g, std::size_t lo, std::size_t hi, const ClipVolume& volume) {
+// Outcodes of positions [lo, hi), and the screen positions of those inside the volume: a triangle
+// of three such vertices is set up without clipping, and each vertex is projected once instead of
+// once for each of its triangles.
+void classify_and_project(ClipSpaceGeometry& g, std::size_t lo, std::size_t hi, const ClipVolume& volume,
+                          const Viewport& viewport) {
     for (std::size_t i = lo; i < hi; ++i) {
         const glm::dvec4& p = g.positions[i];
         const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w);
         g.outcodes[i] = finite ? outcode(p, volume) : kNonFinite;
+        if (g.outcodes[i] == 0) g.screen[i] = project_vertex(p, viewport);
     }
+}
+
+// Sizes a geometry's per-vertex arrays for n vertices.
+void resize_vertices(ClipSpaceGeometry& g, std::size_t n) {
+    reserve_on_huge_pages(g.positions, n);
+    g.positions.resize(n);
+    g.outcodes.resize(n);
+    reserve_on_huge_pages(g.screen, n);
+    g.screen.resize(n);
 }
 
 // Vertices per task of the per-vertex stages.
@@ -134,16 +149,20 @@ void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices,
             ++counters.dropped_nonfinite;
             continue;
         }
-        const std::array<glm::dvec4, 3> p = {vertices.positions[tri[0]], vertices.positions[tri[1]],
-                                             vertices.positions[tri[2]]};
         st.triangle = t;
         st.draw = range.draw;
+        if ((codes[0] | codes[1] | codes[2]) == 0) {  // inside: its vertices are projected already
+            st.clip_index = -1;
+            if (setup_triangle({vertices.screen[tri[0]], vertices.screen[tri[1]], vertices.screen[tri[2]]}, viewport,
+                               vertices.cull, st, counters))
+                chunk.triangles.push_back(st);
+            continue;
+        }
+        const std::array<glm::dvec4, 3> p = {vertices.positions[tri[0]], vertices.positions[tri[1]],
+                                             vertices.positions[tri[2]]};
         switch (clip_triangle(p, codes, volume, polygon)) {
+            case ClipOutcome::inside:  // (only for outcodes that OR to 0: set up above)
             case ClipOutcome::outside: ++counters.culled_outside; break;
-            case ClipOutcome::inside:
-                st.clip_index = -1;
-                if (setup_triangle(p, viewport, vertices.cull, st, counters)) chunk.triangles.push_back(st);
-                break;
             case ClipOutcome::clipped: {
                 ++clipped;
                 if (projects_to_a_line(p)) {  // zero area: clipping would round area into it
@@ -282,7 +301,7 @@ void add_counters(const std::vector<TileCounters>& tiles, RenderStats& stats) {
 
 // Per vertex and per triangle of the input, what transform, setup and binning hold.
 std::uint64_t geometry_bytes(std::uint64_t vertices, std::uint64_t triangles) {
-    return vertices * (sizeof(glm::dvec4) + 1) + triangles * (sizeof(SetupTriangle) + 2 * sizeof(std::uint32_t));
+    return vertices * (sizeof(glm::dvec4) + 1 + sizeof(ScreenVertex)) + triangles * (sizeof(SetupTriangle) + 2 * sizeof(std::uint32_t));
 }
 
 // What a render allocates, estimated before it allocates: the output images, the kept samples,
@@ -391,6 +410,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     // Stage 1: vertex transform, per draw, in parallel over blocks of vertices.
     auto t0 = Clock::now();
     const ClipVolume volume = make_clip_volume(camera.depth_convention, settings.width, settings.height);
+    const Viewport viewport{settings.width, settings.height, camera.depth_convention};
     std::vector<ClipSpaceGeometry> geometry(draws.size());
     for (std::size_t d = 0; d < draws.size(); ++d) {
         const Mesh& mesh = *draws[d].mesh;
@@ -398,13 +418,11 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         ClipSpaceGeometry& g = geometry[d];
         g.triangles = &mesh.triangles;
         g.cull = draws[d].state.cull;
-        reserve_on_huge_pages(g.positions, mesh.positions.size());
-        g.positions.resize(mesh.positions.size());
-        g.outcodes.resize(mesh.positions.size());
+        resize_vertices(g, mesh.positions.size());
         pool.parallel_for((mesh.positions.size() + kVertexBlock - 1) / kVertexBlock, [&](std::size_t b) {
             const std::size_t lo = b * kVertexBlock, hi = std::min(lo + kVertexBlock, mesh.positions.size());
             transform_vertices(&mesh.positions[lo], hi - lo, mvp, &g.positions[lo]);
-            compute_outcodes(g, lo, hi, volume);
+            classify_and_project(g, lo, hi, volume, viewport);
         });
     }
     stats.transform_ms = ms_since(t0);
@@ -447,7 +465,6 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     // deferred).
     t0 = Clock::now();
     const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
-    const Viewport viewport{settings.width, settings.height, camera.depth_convention};
     const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, deferred, pool, stats);
     stats.setup_ms = ms_since(t0);
 
@@ -589,24 +606,25 @@ Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::v
     RenderStats& stats = out.stats;
     stats.threads = threads;
 
-    // Stage 1: outcodes of the given clip-space vertices.
+    // Stage 1: outcodes and screen positions of the given clip-space vertices.
     auto t0 = Clock::now();
     const ClipVolume volume = make_clip_volume(settings.depth_convention, settings.width, settings.height);
+    const Viewport viewport{settings.width, settings.height, settings.depth_convention};
     std::vector<ClipSpaceGeometry> geometry(1);
     ClipSpaceGeometry& g = geometry[0];
-    g.positions.assign(clip_positions.begin(), clip_positions.end());
-    g.outcodes.resize(clip_positions.size());
+    resize_vertices(g, clip_positions.size());
+    std::copy(clip_positions.begin(), clip_positions.end(), g.positions.begin());
     g.triangles = &triangles;
     g.cull = settings.cull;
     pool.parallel_for((clip_positions.size() + kVertexBlock - 1) / kVertexBlock, [&](std::size_t b) {
-        compute_outcodes(g, b * kVertexBlock, std::min((b + 1) * kVertexBlock, clip_positions.size()), volume);
+        classify_and_project(g, b * kVertexBlock, std::min((b + 1) * kVertexBlock, clip_positions.size()), volume,
+                             viewport);
     });
     stats.transform_ms = ms_since(t0);
 
     // Stage 2: clip, set up and bin.
     t0 = Clock::now();
     const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
-    const Viewport viewport{settings.width, settings.height, settings.depth_convention};
     const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, false, pool, stats);
     stats.setup_ms = ms_since(t0);
 

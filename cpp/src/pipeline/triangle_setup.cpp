@@ -16,28 +16,40 @@ std::int64_t floor_to_pixel(std::int64_t v) {
 
 }  // namespace
 
-bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport, CullMode cull, SetupTriangle& out,
-                    SetupCounters& counters) {
-    // Step 1: project to screen (y down) and snap to 1/256 px, round half to even (the default
-    // rounding mode of nearbyint). Clipping bounded |x|, |y| by the guard band.
-    std::int64_t X[3], Y[3];
-    double zw[3], inv_w[3];
+ScreenVertex project_vertex(const glm::dvec4& p, const Viewport& viewport) {
+    // Snap to 1/256 px, round half to even (the default rounding mode of nearbyint). Clipping
+    // bounded |x|, |y| by the guard band.
     const double half_w = 0.5 * viewport.width, half_h = 0.5 * viewport.height;
     const double limit = static_cast<double>(kMaxFixedCoordinate);
-    for (int i = 0; i < 3; ++i) {
-        inv_w[i] = 1.0 / p[i].w;
-        const double xs = std::nearbyint((p[i].x * inv_w[i] + 1.0) * half_w * kSubpixelOne);
-        const double ys = std::nearbyint((1.0 - p[i].y * inv_w[i]) * half_h * kSubpixelOne);
-        const double z = p[i].z * inv_w[i];
-        zw[i] = viewport.depth_convention == DepthConvention::opengl ? 0.5 * z + 0.5 : z;
-        // Only finite, in-range values may be converted to integers.
-        if (!(std::fabs(xs) <= limit && std::fabs(ys) <= limit && std::isfinite(zw[i]) && std::isfinite(inv_w[i]))) {
-            ++counters.dropped_nonfinite;
-            return false;
-        }
-        X[i] = static_cast<std::int64_t>(xs);
-        Y[i] = static_cast<std::int64_t>(ys);
+    const double inv_w = 1.0 / p.w;
+    const double xs = std::nearbyint((p.x * inv_w + 1.0) * half_w * kSubpixelOne);
+    const double ys = std::nearbyint((1.0 - p.y * inv_w) * half_h * kSubpixelOne);
+    const double z = p.z * inv_w;
+    ScreenVertex v;
+    v.depth = viewport.depth_convention == DepthConvention::opengl ? 0.5 * z + 0.5 : z;
+    // Only finite, in-range values may be converted to integers.
+    if (!(std::fabs(xs) <= limit && std::fabs(ys) <= limit && std::isfinite(v.depth) && std::isfinite(inv_w))) return v;
+    v.x = static_cast<std::int32_t>(xs);
+    v.y = static_cast<std::int32_t>(ys);
+    v.inv_w = static_cast<float>(inv_w);
+    v.valid = true;
+    return v;
+}
+
+bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport, CullMode cull, SetupTriangle& out,
+                    SetupCounters& counters) {
+    return setup_triangle({project_vertex(p[0], viewport), project_vertex(p[1], viewport), project_vertex(p[2], viewport)},
+                          viewport, cull, out, counters);
+}
+
+bool setup_triangle(const std::array<ScreenVertex, 3>& v, const Viewport& viewport, CullMode cull, SetupTriangle& out,
+                    SetupCounters& counters) {
+    // Step 1: the projected, snapped vertices.
+    if (!(v[0].valid && v[1].valid && v[2].valid)) {
+        ++counters.dropped_nonfinite;
+        return false;
     }
+    const std::int64_t X[3] = {v[0].x, v[1].x, v[2].x}, Y[3] = {v[0].y, v[1].y, v[2].y};
 
     // Step 2: orientation and culling. In y-down coordinates area2 > 0 means the triangle
     // appears clockwise (on screen and in NDC alike: the flip changes the formula's sign, not
@@ -84,10 +96,10 @@ bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport
     out.inv_area2 = 1.0 / static_cast<double>(sign * area2);
 
     // Step 5: depth (affine in screen space) and 1/w planes.
-    out.z0 = zw[0];
-    out.dz1 = zw[1] - zw[0];
-    out.dz2 = zw[2] - zw[0];
-    for (int i = 0; i < 3; ++i) out.inv_w[i] = static_cast<float>(inv_w[i]);
+    out.z0 = v[0].depth;
+    out.dz1 = v[1].depth - v[0].depth;
+    out.dz2 = v[2].depth - v[0].depth;
+    for (int i = 0; i < 3; ++i) out.inv_w[i] = v[i].inv_w;
     return true;
 }
 

@@ -41,9 +41,27 @@ struct Viewport {
     DepthConvention depth_convention = DepthConvention::reverse_z;
 };
 
-/// Sets up the triangle with clip-space vertices p[0..2]. Returns false (and counts why) when it
-/// is culled: back/front facing per `cull`, zero area after snapping, no pixel of the viewport in
-/// its bounds, or a non-finite projected coordinate.
+/// A clip-space vertex on the screen: its position snapped to 1/256 px (y down), its window depth
+/// and 1/w. `valid` is false when a projected coordinate is not finite or beyond
+/// kMaxFixedCoordinate; the other fields are then meaningless.
+struct ScreenVertex {
+    std::int32_t x = 0, y = 0;
+    float inv_w = 0.0f;
+    bool valid = false;
+    double depth = 0.0;
+};
+
+/// Projects and snaps one clip-space vertex. A vertex shared by several triangles is projected
+/// once: the result is the same whichever triangle asks.
+ScreenVertex project_vertex(const glm::dvec4& p, const Viewport& viewport);
+
+/// Sets up the triangle with screen vertices v[0..2]. Returns false (and counts why) when it is
+/// culled: an invalid vertex, back/front facing per `cull`, zero area after snapping, or no pixel
+/// of the viewport in its bounds.
+bool setup_triangle(const std::array<ScreenVertex, 3>& v, const Viewport& viewport, CullMode cull, SetupTriangle& out,
+                    SetupCounters& counters);
+
+/// The same for clip-space vertices p[0..2], projected here.
 bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport, CullMode cull, SetupTriangle& out,
                     SetupCounters& counters);
 
