@@ -80,6 +80,10 @@ template <typename V>
     std::memcpy(&r, p, sizeof r);
     return r;
 }
+template <typename T, typename V>
+[[gnu::always_inline]] inline void store_v(T* p, V x) {
+    std::memcpy(p, &x, sizeof x);
+}
 
 // Per lane, what the blend needs: which level(s), the weight of the finer one's neighbour,
 // the texel indices of the bilinear quads and their fractions.
@@ -199,10 +203,14 @@ template <int W>
         axis<W>(v, hk, convert<Ints>(hk), s.wrap_v, j0, j1, fy);
         const Ints wk_int = convert<Ints>(wk);
         const Ints row0 = j0 * wk_int, row1 = j1 * wk_int;
-        const Ints quad[4] = {row0 + i0, row0 + i1, row1 + i0, row1 + i1};
-        for (int c = 0; c < 4; ++c) std::memcpy(plan.texel[step][c] + first, &quad[c], sizeof quad[c]);
-        std::memcpy(plan.fx[step] + first, &fx, sizeof fx);
-        std::memcpy(plan.fy[step] + first, &fy, sizeof fy);
+        // (Four stores, not a loop over an array of vectors: GCC copied such an array through the
+        // stack in halves, and the reloads waited on the wide stores.)
+        store_v(plan.texel[step][0] + first, row0 + i0);
+        store_v(plan.texel[step][1] + first, row0 + i1);
+        store_v(plan.texel[step][2] + first, row1 + i0);
+        store_v(plan.texel[step][3] + first, row1 + i1);
+        store_v(plan.fx[step] + first, fx);
+        store_v(plan.fy[step] + first, fy);
     }
     std::memcpy(plan.finite + first, &finite, sizeof finite);
 }
