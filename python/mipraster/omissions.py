@@ -219,7 +219,7 @@ OMISSIONS = [
                      ortho_textured(force_division=False)),
              Variant("w = 1 + 1e-9·x (the division per sample)", ortho_textured(force_division=True)), "close"),
     Omission("no resolve at 1 sample", "colour grid, 1 sample",
-             Variant("tile writes straight into the image", colour_grid()),
+             Variant("tiles copy their samples into the image", colour_grid()),
              Variant("keep_samples: whole-frame sample buffer + resolve pass (+ samples returned)",
                      with_options(colour_grid(), keep_samples=True)), "exact"),
     Omission("no depth buffer when nothing tests depth", "colour grid (no overlaps)",

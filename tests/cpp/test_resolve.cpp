@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 #include <limits>
 #include <random>
@@ -121,6 +122,28 @@ TEST(Resolve, BoxResolveIsTheMeanOfEachPixelsSamplesForRandomData) {
                     EXPECT_EQ(tile.at(x, y, c), inside ? img.at(x, y, c) : 0.0f) << "S=" << S << " (" << x << ", " << y << ")";
                 }
     }
+}
+
+// One sample per pixel resolves by copying (the renderer's 1x path): every bit arrives, signed
+// zeros, infinities, subnormals and NaN payloads included, in a window with its own pitch.
+TEST(Resolve, OneSampleResolveCopiesEveryBit) {
+    const std::uint32_t patterns[] = {0x80000000u, 0x7f800000u, 0xff800000u, 0x00000001u, 0x7fc12345u,
+                                      0xffa00001u, 0x3f800000u, 0xc0490fdbu};
+    const int x0 = 3, y0 = 1, x1 = 9, y1 = 4, pitch = 7;
+    std::vector<float> local(static_cast<std::size_t>(pitch) * (y1 - y0) * 4);
+    for (std::size_t i = 0; i < local.size(); ++i) std::memcpy(&local[i], &patterns[(i * 5 + i / 3) % 8], 4);
+    const mr::SampleWindow window{local.data(), 4, x0, y0, pitch, 1};
+    mr::Image out(x1 + 2, y1 + 1, 4);
+    mr::resolve_tile(window, x0, y0, x1, y1, mr::ResolveFilter::box, out);
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x)
+            for (int c = 0; c < 4; ++c) {
+                const bool inside = x >= x0 && x < x1 && y >= y0 && y < y1;
+                std::uint32_t got, want = 0;
+                std::memcpy(&got, &out.at(x, y, c), 4);
+                if (inside) std::memcpy(&want, &window.at(x, y, 0)[c], 4);
+                EXPECT_EQ(got, want) << "(" << x << ", " << y << ") channel " << c;
+            }
 }
 
 // The mean of finite samples is finite, however large they are: the sum must not overflow.

@@ -470,8 +470,8 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
 
     // Stage 3: per tile, one task each: clear, rasterize (shade, depth test, blend) the tile's
     // triangles in submission order, and resolve. The samples live in a tile-local buffer that
-    // stays in cache; a whole-frame sample buffer exists only when the caller keeps the samples,
-    // and at one sample per pixel the colour goes straight into the image (no resolve at all).
+    // stays in cache, and a whole-frame sample buffer exists only when the caller keeps the
+    // samples; at one sample per pixel the resolve is a copy.
     t0 = Clock::now();
     const int S = settings.samples;
     const float clear_depth = camera.depth_convention == DepthConvention::opengl ? 1.0f : 0.0f;
@@ -515,12 +515,8 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             target.color = color_window(kept);
             target.depth = depth_window(kept);
         } else {
-            if (S == 1) {
-                target.color = {result.color.pixels.data(), 4, 0, 0, settings.width, 1};
-            } else {
-                tile_color.resize(std::size_t{4} * kTileSize * kTileSize * static_cast<std::size_t>(S));
-                target.color = {tile_color.data(), 4, target.x0, target.y0, kTileSize, S};
-            }
+            tile_color.resize(std::size_t{4} * kTileSize * kTileSize * static_cast<std::size_t>(S));
+            target.color = {tile_color.data(), 4, target.x0, target.y0, kTileSize, S};
             if (needs_depth) {
                 tile_depth.resize(std::size_t{kTileSize} * kTileSize * static_cast<std::size_t>(S));
                 target.depth = {tile_depth.data(), 1, target.x0, target.y0, kTileSize, S};
@@ -530,7 +526,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         // triangle's bounding box to the target's rectangle). Each span repeats the edge setup of
         // every triangle in the tile, so a tile with at least kWholeTileShare of its pixels listed
         // is rasterized whole into its tile-local buffer and only the listed spans are resolved
-        // (not with S == 1 or a kept framebuffer, where the samples are the output).
+        // (not with a kept framebuffer, where the samples are the output).
         const PixelSpan whole{target.y0, target.x0, target.x1};
         const PixelSpan* first = listed ? spans[tile].data() : &whole;
         const PixelSpan* last = listed ? first + spans[tile].size() : &whole + 1;
@@ -538,7 +534,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         for (const PixelSpan* span = first; span != last; ++span) listed_pixels += span->x1 - span->x0;
         const int tile_pixels = (target.x1 - target.x0) * (target.y1 - target.y0);
         const bool rasterize_whole =
-            !listed || (S > 1 && !whole_frame && listed_pixels >= kWholeTileShare * tile_pixels);
+            !listed || (!whole_frame && listed_pixels >= kWholeTileShare * tile_pixels);
         if (rasterize_whole) {
             if (!whole_frame) {  // a kept framebuffer starts cleared
                 target.color.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
@@ -559,7 +555,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 }
                 rasterize_tile_chunks(tile, chunks, kernels, inputs, part, counters);
             }
-            if ((settings.keep_samples || S > 1) && !wide_resolve)
+            if (!wide_resolve)
                 resolve_tile(part.color, part.x0, part.y0, part.x1, part.y1, settings.resolve_filter, result.color);
             if (settings.estimate_error)
                 estimate_tile_error(part.color, halves, part.x0, part.y0, part.x1, part.y1, result.error_map);
