@@ -7,10 +7,6 @@
 
 namespace mipraster {
 
-double ClipPlane::distance(const glm::dvec4& p) const {
-    return normal.x * p.x + normal.y * p.y + normal.z * p.z + normal.w * p.w + offset;
-}
-
 ClipVolume make_clip_volume(DepthConvention convention, int width, int height) {
     // |x_ndc| ≤ gx keeps the screen x within kGuardBandPx of the viewport centre.
     const double gx = 2.0 * kGuardBandPx / width, gy = 2.0 * kGuardBandPx / height;
@@ -66,13 +62,6 @@ bool projects_to_a_line(const std::array<glm::dvec4, 3>& p) {
     const double det = p[0].x * m0 - p[0].y * m1 + p[0].w * m2;
     const double permanent = std::fabs(p[0].x) * n0 + std::fabs(p[0].y) * n1 + std::fabs(p[0].w) * n2;
     return std::fabs(det) <= kProjectedAreaRoundingUlps * std::numeric_limits<double>::epsilon() * permanent;
-}
-
-std::uint8_t outcode(const glm::dvec4& p, const ClipVolume& volume) {
-    std::uint8_t code = 0;
-    for (int i = 0; i < kClipPlaneCount; ++i)
-        if (!(volume.planes[i].distance(p) >= 0.0)) code |= static_cast<std::uint8_t>(1u << i);
-    return code;
 }
 
 ClipOutcome clip_triangle(const std::array<glm::dvec4, 3>& p, const std::array<std::uint8_t, 3>& outcodes,

@@ -71,8 +71,9 @@ void resize_vertices(ClipSpaceGeometry& g, std::size_t n) {
     g.screen.resize(n);
 }
 
-// Vertices per task of the per-vertex stages.
+// Vertices per task of the per-vertex stages, and per run of each stage within a task.
 constexpr std::size_t kVertexBlock = 1 << 16;
+constexpr std::size_t kVertexRun = 512;
 
 // Triangles per chunk: enough chunks for load balance, few enough that per-chunk tile tables stay
 // small. The split never changes the output (see BinnedChunk).
@@ -420,9 +421,13 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         g.cull = draws[d].state.cull;
         resize_vertices(g, mesh.positions.size());
         pool.parallel_for((mesh.positions.size() + kVertexBlock - 1) / kVertexBlock, [&](std::size_t b) {
-            const std::size_t lo = b * kVertexBlock, hi = std::min(lo + kVertexBlock, mesh.positions.size());
-            transform_vertices(&mesh.positions[lo], hi - lo, mvp, &g.positions[lo]);
-            classify_and_project(g, lo, hi, volume, viewport);
+            const std::size_t end = std::min((b + 1) * kVertexBlock, mesh.positions.size());
+            // A few hundred vertices at a time: classified while the transform's output is in cache.
+            for (std::size_t lo = b * kVertexBlock; lo < end; lo += kVertexRun) {
+                const std::size_t hi = std::min(lo + kVertexRun, end);
+                transform_vertices(&mesh.positions[lo], hi - lo, mvp, &g.positions[lo]);
+                classify_and_project(g, lo, hi, volume, viewport);
+            }
         });
     }
     stats.transform_ms = ms_since(t0);

@@ -16,26 +16,6 @@ std::int64_t floor_to_pixel(std::int64_t v) {
 
 }  // namespace
 
-ScreenVertex project_vertex(const glm::dvec4& p, const Viewport& viewport) {
-    // Snap to 1/256 px, round half to even (the default rounding mode of nearbyint). Clipping
-    // bounded |x|, |y| by the guard band.
-    const double half_w = 0.5 * viewport.width, half_h = 0.5 * viewport.height;
-    const double limit = static_cast<double>(kMaxFixedCoordinate);
-    const double inv_w = 1.0 / p.w;
-    const double xs = std::nearbyint((p.x * inv_w + 1.0) * half_w * kSubpixelOne);
-    const double ys = std::nearbyint((1.0 - p.y * inv_w) * half_h * kSubpixelOne);
-    const double z = p.z * inv_w;
-    ScreenVertex v;
-    v.depth = viewport.depth_convention == DepthConvention::opengl ? 0.5 * z + 0.5 : z;
-    // Only finite, in-range values may be converted to integers.
-    if (!(std::fabs(xs) <= limit && std::fabs(ys) <= limit && std::isfinite(v.depth) && std::isfinite(inv_w))) return v;
-    v.x = static_cast<std::int32_t>(xs);
-    v.y = static_cast<std::int32_t>(ys);
-    v.inv_w = static_cast<float>(inv_w);
-    v.valid = true;
-    return v;
-}
-
 bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport, CullMode cull, SetupTriangle& out,
                     SetupCounters& counters) {
     return setup_triangle({project_vertex(p[0], viewport), project_vertex(p[1], viewport), project_vertex(p[2], viewport)},

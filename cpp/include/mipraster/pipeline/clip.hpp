@@ -21,7 +21,9 @@ struct ClipVertex {
 struct ClipPlane {
     glm::dvec4 normal;
     double offset = 0.0;
-    double distance(const glm::dvec4& p) const;
+    double distance(const glm::dvec4& p) const {  // (inline: seven per vertex)
+        return normal.x * p.x + normal.y * p.y + normal.z * p.z + normal.w * p.w + offset;
+    }
 };
 
 inline constexpr int kClipPlaneCount = 7;  // near, far, w > 0, and four guard-band sides
@@ -45,7 +47,12 @@ enum class ClipOutcome { inside, outside, clipped };
 
 /// Bit i set ⇔ p is outside plane i. Computed once per vertex; a triangle is trivially inside
 /// when its vertices' outcodes OR to 0 and trivially outside when they AND to non-zero.
-std::uint8_t outcode(const glm::dvec4& p, const ClipVolume& volume);
+inline std::uint8_t outcode(const glm::dvec4& p, const ClipVolume& volume) {
+    std::uint8_t code = 0;
+    for (int i = 0; i < kClipPlaneCount; ++i)
+        if (!(volume.planes[i].distance(p) >= 0.0)) code |= static_cast<std::uint8_t>(1u << i);
+    return code;
+}
 
 /// Whether the triangle projects to a line (or a point): its homogeneous vertices (x, y, w) are
 /// linearly dependent — collinear on screen, or in a plane through the eye — up to the rounding

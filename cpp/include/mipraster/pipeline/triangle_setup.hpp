@@ -2,11 +2,13 @@
 // Triangle setup: project and snap to 16.8 fixed point, cull, and build the exact integer edge
 // equations (top-left rule folded in) and the depth and 1/w planes the rasterizer steps.
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "mipraster/core/constants.hpp"
 #include "mipraster/pipeline/draw.hpp"
 #include "mipraster/scene/camera.hpp"
 
@@ -52,8 +54,27 @@ struct ScreenVertex {
 };
 
 /// Projects and snaps one clip-space vertex. A vertex shared by several triangles is projected
-/// once: the result is the same whichever triangle asks.
-ScreenVertex project_vertex(const glm::dvec4& p, const Viewport& viewport);
+/// once: the result is the same whichever triangle asks. (Inline: returned through memory, the
+/// struct's reload waited on its stores.)
+inline ScreenVertex project_vertex(const glm::dvec4& p, const Viewport& viewport) {
+    // Snap to 1/256 px, round half to even (the default rounding mode of nearbyint). Clipping
+    // bounded |x|, |y| by the guard band.
+    const double half_w = 0.5 * viewport.width, half_h = 0.5 * viewport.height;
+    const double limit = static_cast<double>(kMaxFixedCoordinate);
+    const double inv_w = 1.0 / p.w;
+    const double xs = std::nearbyint((p.x * inv_w + 1.0) * half_w * kSubpixelOne);
+    const double ys = std::nearbyint((1.0 - p.y * inv_w) * half_h * kSubpixelOne);
+    const double z = p.z * inv_w;
+    ScreenVertex v;
+    v.depth = viewport.depth_convention == DepthConvention::opengl ? 0.5 * z + 0.5 : z;
+    // Only finite, in-range values may be converted to integers.
+    if (!(std::fabs(xs) <= limit && std::fabs(ys) <= limit && std::isfinite(v.depth) && std::isfinite(inv_w))) return v;
+    v.x = static_cast<std::int32_t>(xs);
+    v.y = static_cast<std::int32_t>(ys);
+    v.inv_w = static_cast<float>(inv_w);
+    v.valid = true;
+    return v;
+}
 
 /// Sets up the triangle with screen vertices v[0..2]. Returns false (and counts why) when it is
 /// culled: an invalid vertex, back/front facing per `cull`, zero area after snapping, or no pixel
