@@ -115,6 +115,39 @@ TEST(BlockSkipping, ATriangleOverAWholeTileIsTestedAgainstEveryBlockOfIt) {
             }
 }
 
+// A block is classified where a triangle's bounding box holds at least kBlockMinPixels of its
+// pixels; a smaller box is not classified at all (small triangles skip the call). Behind a
+// full-screen occluder, block (w − 1, h − 1) holds one triangle whose box is w × h pixels: the
+// blocks rejected by depth are exactly those with w·h ≥ 16.
+TEST(BlockSkipping, BoundingBoxesFromSixteenPixelsAreClassified) {
+    const int W = 64, H = 64;
+    mr::Mesh front, behind;
+    for (glm::vec3 p : {glm::vec3(0, 0, -0.5f), glm::vec3(W * 256, 0, -0.5f), glm::vec3(W * 256, H * 256, -0.5f),
+                        glm::vec3(0, H * 256, -0.5f)})
+        front.positions.push_back(p);
+    add_triangle(front, 0, 1, 2);
+    add_triangle(front, 0, 2, 3);
+    int expected = 0;
+    for (int w = 1; w <= 8; ++w)
+        for (int h = 1; h <= 8; ++h) {
+            // Pixels x0 … x0 + w − 1 and y0 … y0 + h − 1: vertices a quarter pixel in from the box.
+            const float x0 = (w - 1) * 8 * 256.0f, y0 = (h - 1) * 8 * 256.0f;
+            const auto first = static_cast<std::uint32_t>(behind.positions.size());
+            behind.positions.push_back({x0 + 64, y0 + 64, 0.5f});
+            behind.positions.push_back({x0 + (w - 1) * 256 + 192, y0 + 64, 0.5f});
+            behind.positions.push_back({x0 + 64, y0 + (h - 1) * 256 + 192, 0.5f});
+            add_triangle(behind, first, first + 1, first + 2);
+            expected += w * h >= 16;  // (kBlockMinPixels, tile_blocks.hpp)
+        }
+    auto s = settings(W, H, 1);
+    const glm::dmat4 model = fixed_to_ndc(W, H);
+    const mr::RenderResult r =
+        mr::render({make_draw(front, model, {}), make_draw(behind, model, {})}, identity_camera(), s);
+    EXPECT_EQ(r.stats.depth_blocks_rejected, std::uint64_t(expected));
+    EXPECT_EQ(r.stats.samples_passed, std::uint64_t(W) * H);  // the occluder's own
+    EXPECT_EQ(r.stats.triangles_rasterized, 2u + 64u);
+}
+
 TEST(BlockSkipping, AnOccluderDrawnFirstHidesEveryBlockBehindIt) {
     // A full-screen quad at z = 1, then 50 triangles behind it at z = −1 that cover the screen:
     // each of them fails everywhere, so every block they fill is skipped and no sample passes.

@@ -147,13 +147,22 @@ public:
     /// Classifies the blocks of t's bounding box [x0, x1) × [y0, y1) (clipped to the target) with
     /// S samples per pixel; kDepth none tests coverage only.
     template <DepthFunc kDepth>
-    BlockClasses classify(const SetupTriangle& t, int x0, int y0, int x1, int y1, int S) {
+    [[gnu::always_inline]] BlockClasses classify(const SetupTriangle& t, int x0, int y0, int x1, int y1, int S) {
+        const bool whole = x0 == target_.x0 && y0 == target_.y0 && x1 == target_.x1 && y1 == target_.y1;
+        // Fewer pixels than a block needs: no block of the box can be classified (the common case
+        // of small triangles, which so skip the call).
+        if (!whole && (x1 - x0) * (y1 - y0) < kBlockMinPixels) return {};
+        return classify_blocks<kDepth>(t, x0, y0, x1, y1, S, whole);
+    }
+
+private:
+    template <DepthFunc kDepth>
+    [[gnu::noinline]] BlockClasses classify_blocks(const SetupTriangle& t, int x0, int y0, int x1, int y1, int S,
+                                                   bool whole) {
         BlockClasses out;
         // A triangle whose bounding box holds the whole target is tested on the target first: under
         // heavy overdraw most such triangles cover all of it behind everything stored, or none of it.
-        if (x0 == target_.x0 && y0 == target_.y0 && x1 == target_.x1 && y1 == target_.y1 &&
-            whole_target<kDepth>(t, S, out))
-            return out;
+        if (whole && whole_target<kDepth>(t, S, out)) return out;
         for (int by = y0 >> kBlockShift; by <= (y1 - 1) >> kBlockShift; ++by) {
             const int ry0 = std::max(y0, by << kBlockShift), ry1 = std::min(y1, (by + 1) << kBlockShift);
             for (int bx = x0 >> kBlockShift; bx <= (x1 - 1) >> kBlockShift; ++bx) {
@@ -183,7 +192,6 @@ public:
         return out;
     }
 
-private:
     // The samples of the pixels [x0, x1) × [y0, y1).
     SampleExtent extent(int x0, int y0, int x1, int y1) const {
         return {std::int64_t{x0} * kSubpixelOne + ox0_, std::int64_t{y0} * kSubpixelOne + oy0_,
