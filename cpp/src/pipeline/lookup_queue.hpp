@@ -46,9 +46,18 @@ public:
     /// its colour slot at row_target + 4j and its screen weights l0[j], l1[j], l2[j].
     void push_row(float* row_target, std::uint32_t pixels, const double* l0, const double* l1, const double* l2, int x0,
                   int y) {
-        for (; pixels; pixels &= pixels - 1) {
-            const int j = __builtin_ctz(pixels);
-            enqueue(row_target + 4 * j, 1, l0[j], l1[j], l2[j], x0 + j, y);
+        while (pixels) {
+            // Up to a batch at a time with the count in a register (as a member, each pixel's
+            // stores into pending_ could change it, so it went through memory pixel by pixel).
+            int n = count_;
+            for (; pixels && n < kLookupBatch; pixels &= pixels - 1, ++n) {
+                const int j = __builtin_ctz(pixels);
+                weights_.l0[n] = l0[j], weights_.l1[n] = l1[j], weights_.l2[n] = l2[j];
+                pending_[n] = {row_target + 4 * j, 1, current_, x0 + j, y};
+            }
+            count_ = n;
+            current_queued_ = true;
+            if (n == kLookupBatch) flush();
         }
     }
 

@@ -334,7 +334,13 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
                 std::int64_t e[3];
                 edges_at(px, py, 0, e);
                 if (end - px >= kSampleRowMinPixels && sample_row_weights(*ref.triangle, e, end - px, l0, l1, l2)) {
-                    for (int j = 0; j < end - px; ++j) shade_sample(px + j, py, 0, glm::dvec3(l0[j], l1[j], l2[j]));
+                    const int n = end - px;
+                    if (queue) {  // the run as one mask
+                        counters.shader_invocations += static_cast<std::uint64_t>(n);
+                        queue->push_row(target.color.at(px, py, 0), ~std::uint32_t{0} >> (32 - n), l0, l1, l2, px, py);
+                    } else {
+                        for (int j = 0; j < n; ++j) shade_sample(px + j, py, 0, glm::dvec3(l0[j], l1[j], l2[j]));
+                    }
                 } else {
                     for (int x = px; x < end; ++x) shade_exactly(x, py, 0);
                 }

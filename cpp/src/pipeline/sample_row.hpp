@@ -15,6 +15,8 @@ namespace kernels {
 /// Rows shorter than this take the per-sample path: a vector pass costs more than a few samples.
 inline constexpr int kSampleRowMinPixels = 8;
 
+static_assert(kTileSize <= 32, "a tile row's pixels fit a 32-bit mask");
+
 /// What test_sample_row found along a row of n ≤ kTileSize pixels; bit j is pixel j.
 struct SampleRow {
     std::uint32_t covered;  ///< the pixel's sample is inside the triangle
