@@ -9,8 +9,13 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
+#include <random>
 #include <string>
 #include <vector>
+
+#include <glm/common.hpp>
 
 #include "helpers.hpp"
 #include "oracle.hpp"
@@ -253,6 +258,31 @@ TEST(Interpolate, ScreenAndPerspectiveInterpolationDifferOnTheTiltedQuad) {
     float most = 0.0f;
     for (std::size_t i = 0; i < a.color.pixels.size(); i += 4) most = std::max(most, std::fabs(a.color.pixels[i] - b.color.pixels[i]));
     EXPECT_GT(most, 0.05f);
+}
+
+// VertexValues' range is glm's component-wise min and max, bit for bit: random values with ties,
+// signed zeros, infinities and NaNs in every position (the selections must match glm's, which
+// keep the first argument unless the second compares less or greater).
+TEST(Interpolate, VertexValuesRangeIsGlmsMinAndMax) {
+    const float special[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, std::numeric_limits<float>::infinity(),
+                             -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN(), 1e-40f};
+    std::mt19937 rng(15);
+    std::uniform_int_distribution<int> pick(0, 8);
+    const auto bits = [](float x) {
+        std::uint32_t b;
+        std::memcpy(&b, &x, 4);
+        return b;
+    };
+    for (int trial = 0; trial < 20000; ++trial) {
+        glm::vec4 a, b, c;
+        for (int k = 0; k < 4; ++k) a[k] = special[pick(rng)], b[k] = special[pick(rng)], c[k] = special[pick(rng)];
+        const mr::VertexValues values(a, b, c);
+        const glm::vec4 lo = glm::min(a, glm::min(b, c)), hi = glm::max(a, glm::max(b, c));
+        for (int k = 0; k < 4; ++k) {
+            ASSERT_EQ(bits(values.lo[k]), bits(lo[k])) << "trial " << trial << " component " << k;
+            ASSERT_EQ(bits(values.hi[k]), bits(hi[k])) << "trial " << trial << " component " << k;
+        }
+    }
 }
 
 TEST(Interpolate, InterpolatedValuesStayWithinTheVertexValuesRange) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include <glm/common.hpp>
 #include <glm/vec3.hpp>
@@ -59,8 +60,19 @@ struct VertexValues {
     glm::vec4 lo, hi;
 
     VertexValues() = default;
-    VertexValues(const glm::vec4& a, const glm::vec4& b, const glm::vec4& c)
-        : v{a, b, c}, lo(glm::min(a, glm::min(b, c))), hi(glm::max(a, glm::max(b, c))) {}
+    /// lo = glm::min(a, glm::min(b, c)) and hi = glm::max(a, glm::max(b, c)), four components at
+    /// once: glm's min(x, y) is y < x ? y : x and max(x, y) is x < y ? y : x, selected the same way.
+    VertexValues(const glm::vec4& a, const glm::vec4& b, const glm::vec4& c) : v{a, b, c} {
+        typedef float Four __attribute__((vector_size(16)));
+        Four x, y, z;
+        std::memcpy(&x, &a, sizeof x);
+        std::memcpy(&y, &b, sizeof y);
+        std::memcpy(&z, &c, sizeof z);
+        const Four min_yz = z < y ? z : y, max_yz = y < z ? z : y;
+        const Four low = min_yz < x ? min_yz : x, high = x < max_yz ? max_yz : x;
+        std::memcpy(&lo, &low, sizeof lo);
+        std::memcpy(&hi, &high, sizeof hi);
+    }
 
     /// Σ w_i·v_i, clamped to the vertex values' range so rounding never leaves it.
     glm::vec4 interpolate(const glm::dvec3& w) const {
