@@ -42,7 +42,7 @@ struct ChunkRange {
 struct ClipSpaceGeometry {
     RecycledVector<glm::dvec4> positions;
     std::vector<std::uint8_t> outcodes;
-    RecycledVector<ScreenVertex> screen;  // (left default where the outcode is not 0)
+    RecycledVector<ScreenVertex> screen;  // (set and read only where the outcode is 0)
     const std::vector<glm::uvec3>* triangles = nullptr;
     CullMode cull = CullMode::none;
 };
@@ -302,7 +302,8 @@ void add_counters(const std::vector<TileCounters>& tiles, RenderStats& stats) {
 
 // Per vertex and per triangle of the input, what transform, setup and binning hold.
 std::uint64_t geometry_bytes(std::uint64_t vertices, std::uint64_t triangles) {
-    return vertices * (sizeof(glm::dvec4) + 1 + sizeof(ScreenVertex)) + triangles * (sizeof(SetupTriangle) + 2 * sizeof(std::uint32_t));
+    return vertices * (sizeof(glm::dvec4) + 1 + sizeof(ScreenVertex)) +
+           triangles * (sizeof(SetupTriangle) + 2 * sizeof(std::uint32_t));
 }
 
 // What a render allocates, estimated before it allocates: the output images, the kept samples,

@@ -18,8 +18,9 @@ std::int64_t floor_to_pixel(std::int64_t v) {
 
 bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport, CullMode cull, SetupTriangle& out,
                     SetupCounters& counters) {
-    return setup_triangle({project_vertex(p[0], viewport), project_vertex(p[1], viewport), project_vertex(p[2], viewport)},
-                          viewport, cull, out, counters);
+    const std::array<ScreenVertex, 3> v = {project_vertex(p[0], viewport), project_vertex(p[1], viewport),
+                                           project_vertex(p[2], viewport)};
+    return setup_triangle(v, viewport, cull, out, counters);
 }
 
 bool setup_triangle(const std::array<ScreenVertex, 3>& v, const Viewport& viewport, CullMode cull, SetupTriangle& out,
