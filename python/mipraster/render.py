@@ -193,10 +193,11 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             None = W·H·spp/(256·K) within [512, 4096] with K reference passes (2, or 4 at 64 spp):
             a quarter of the render's samples; 0 = no probe (the raw halves estimate; needs
             ``spp >= 2``).
-        deferred_shading: where a tile's triangles overlap 2 or more deep and every draw replaces
-            what lies beneath (1 sample or SSAA), find each sample's visible triangle first and
-            shade it once (``stats["tiles_deferred"]`` counts those tiles). The image is the same
-            bit for bit; False shades every sample that passes its depth test, for comparison.
+        deferred_shading: where a tile's triangles overlap 1.25 or more deep (without a texture,
+            deeper the smaller its triangles) and every draw replaces what lies beneath (1 sample
+            or SSAA), find each sample's visible triangle first and shade it once
+            (``stats["tiles_deferred"]`` counts those tiles). The image is the same bit for bit;
+            False shades every sample that passes its depth test, for comparison.
         batched_lookups: textured draws whose sampler is bilinear or trilinear (isotropic, or
             anisotropic where a footprint needs one probe) with repeat or clamp wrapping look
             their texture up sixteen samples at a time in float. Each lookup is within

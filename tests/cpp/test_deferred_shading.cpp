@@ -131,6 +131,57 @@ TEST(DeferredShading, TileBuffersAndListedPixelsGiveTheForwardImage) {
         }
 }
 
+// Two full-screen layers of a grid of right triangles (cells of `cell` px, vertex colours), the
+// far one first: every sample passes twice, an overdraw of 2 in every tile.
+mr::Mesh two_layers(int width, int height, int cell) {
+    mr::Mesh m;
+    for (float z : {0.5f, -0.5f}) {  // (opengl convention: the second is nearer)
+        const auto first = static_cast<std::uint32_t>(m.positions.size());
+        const int nx = width / cell, ny = height / cell;
+        for (int j = 0; j <= ny; ++j)
+            for (int i = 0; i <= nx; ++i) {
+                m.positions.push_back({i * cell * 256.0f, j * cell * 256.0f, z});
+                m.colors.push_back({0.2f + 0.5f * z, float(i) / nx, float(j) / ny, 1.0f});
+                m.uvs.push_back({float(i) / nx, float(j) / ny});
+            }
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                const std::uint32_t v = first + std::uint32_t(j * (nx + 1) + i);
+                add_triangle(m, v, v + 1, v + std::uint32_t(nx) + 1);
+                add_triangle(m, v + 1, v + std::uint32_t(nx) + 2, v + std::uint32_t(nx) + 1);
+            }
+    }
+    return m;
+}
+
+// Untextured shading is cheap: at an overdraw of 2, tiles of small triangles (8 px²) shade while
+// rasterizing and tiles of large ones (512 px²) are deferred ((O − 1)²·a against
+// kDeferredMinUntexturedGain = 64); with a texture the small ones are deferred too. The images
+// are the forward ones either way.
+TEST(DeferredShading, UntexturedTilesAreDeferredOnlyWithBigEnoughTriangles) {
+    const int W = 64, H = 64;
+    const std::uint64_t tiles = (W / 32) * (H / 32);
+    const mr::Mesh small = two_layers(W, H, 4), large = two_layers(W, H, 32);
+    const mr::Texture texture = checker_texture();
+    struct Case {
+        std::string name;
+        const mr::Mesh* mesh;
+        bool textured;
+        std::uint64_t deferred_tiles;
+    };
+    const Case cases[] = {{"small, untextured", &small, false, 0},
+                          {"large, untextured", &large, false, tiles},
+                          {"small, textured", &small, true, tiles}};
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        mr::Draw draw = make_draw(*c.mesh, fixed_to_ndc(W, H), {});
+        if (c.textured) draw.texture = texture;
+        const Outcome o = render_both({draw}, identity_camera(), settings(W, H, 1));
+        expect_same_image(o);
+        EXPECT_EQ(o.deferred.stats.tiles_deferred, c.deferred_tiles);
+    }
+}
+
 TEST(DeferredShading, BlendingMsaaAndShallowScenesShadeWhileRasterizing) {
     const int W = 64, H = 64;
     const mr::Mesh deep = overlapping(200, 2.5, 61), shallow = overlapping(3, 0.3, 62);

@@ -254,6 +254,23 @@ double tile_overdraw(std::size_t tile, const std::vector<BinnedChunk>& chunks, c
     return area / (double(target.x1 - target.x0) * double(target.y1 - target.y0));
 }
 
+// Whether deferring the tile's shading pays (with RenderSettings::deferred_shading): overdraw
+// from kDeferredMinOverdraw on, and for a tile without textures also big enough triangles
+// (kDeferredMinUntexturedGain).
+bool defer_tile(std::size_t tile, const std::vector<BinnedChunk>& chunks, const std::vector<DrawInputs>& inputs,
+                const TileTarget& target) {
+    const double overdraw = tile_overdraw(tile, chunks, target);
+    if (overdraw < kDeferredMinOverdraw) return false;
+    std::size_t triangles = 0;
+    for (const BinnedChunk& chunk : chunks) {
+        const std::uint32_t first = chunk.tile_start[tile], count = chunk.tile_start[tile + 1] - first;
+        if (count && inputs[chunk.triangles[chunk.tile_triangles[first]].draw].texture) return true;
+        triangles += count;
+    }
+    const double mean_area = overdraw * double(target.x1 - target.x0) * double(target.y1 - target.y0) / double(triangles);
+    return (overdraw - 1.0) * (overdraw - 1.0) * mean_area >= kDeferredMinUntexturedGain;
+}
+
 // Deferred shading of one tile (RenderSettings::deferred_shading): the pre-pass rasterizes and
 // depth-tests every triangle as the forward kernels would, recording for each sample the triangle
 // it ends up with; then each draw shades the samples its triangles own, once each.
@@ -546,7 +563,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 target.color.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
                 if (needs_depth) target.depth.fill(target.x0, target.y0, target.x1, target.y1, clear_depth4);
             }
-            if (deferred && tile_overdraw(tile, chunks, target) >= kDeferredMinOverdraw)
+            if (deferred && defer_tile(tile, chunks, inputs, target))
                 rasterize_tile_deferred(tile, chunks, prepass_kernels, shading_kernels, inputs, target, counters);
             else
                 rasterize_tile_chunks(tile, chunks, kernels, inputs, target, counters);
