@@ -154,14 +154,14 @@ mr::Mesh two_layers(int width, int height, int cell) {
     return m;
 }
 
-// Untextured shading is cheap: at an overdraw of 2, tiles of small triangles (8 px²) shade while
-// rasterizing and tiles of large ones (512 px²) are deferred ((O − 1)²·a against
-// kDeferredMinUntexturedGain = 64); with a texture the small ones are deferred too. The images
-// are the forward ones either way.
+// Untextured shading is cheap: at an overdraw of 2, tiles of tiny triangles (2 px²) shade while
+// rasterizing and tiles of larger ones (8 px²) are deferred ((O − 1)²·a against
+// kDeferredMinUntexturedGain = 4); with a texture the tiny ones are deferred too. The images are
+// the forward ones either way.
 TEST(DeferredShading, UntexturedTilesAreDeferredOnlyWithBigEnoughTriangles) {
     const int W = 64, H = 64;
     const std::uint64_t tiles = (W / 32) * (H / 32);
-    const mr::Mesh small = two_layers(W, H, 4), large = two_layers(W, H, 32);
+    const mr::Mesh small = two_layers(W, H, 2), large = two_layers(W, H, 4);
     const mr::Texture texture = checker_texture();
     struct Case {
         std::string name;

@@ -39,10 +39,10 @@ static_assert(kTileSize % 8 == 0 && kTileSize <= 256, "tile size must be a small
 inline constexpr double kDeferredMinOverdraw = 1.25;
 static_assert(kDeferredMinOverdraw >= 1.0, "deferring pays only where triangles overlap");
 /// Untextured shading is cheap, so a tile without textures is deferred only where its overdraw O
-/// and the mean area a (px²) its triangles cover of it give (O − 1)²·a ≥ this: small triangles
-/// repeat per-triangle work in the pre-pass that the shading they save does not pay for. Measured
-/// (README, "Session 15"): layers of grids of 2 … 512 px² triangles, 2 and 4 layers deep.
-inline constexpr double kDeferredMinUntexturedGain = 64.0;
+/// and the mean area a (px²) its triangles cover of it give (O − 1)²·a ≥ this: tiny triangles at
+/// a low overdraw repeat per-triangle work in the pre-pass that the shading they save does not
+/// pay for. Measured (README, "Session 15"): many_small, and layers of grids of 2 … 128 px².
+inline constexpr double kDeferredMinUntexturedGain = 4.0;
 
 /// Freed large per-render buffers kept for the next buffer of the same size (block_recycler.hpp):
 /// each from the smallest size worth it (a 1024×1024 RGBA float image is 16 MiB) to the largest
