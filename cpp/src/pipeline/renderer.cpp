@@ -267,7 +267,8 @@ bool defer_tile(std::size_t tile, const std::vector<BinnedChunk>& chunks, const 
         if (count && inputs[chunk.triangles[chunk.tile_triangles[first]].draw].texture) return true;
         triangles += count;
     }
-    const double mean_area = overdraw * double(target.x1 - target.x0) * double(target.y1 - target.y0) / double(triangles);
+    const double tile_area = double(target.x1 - target.x0) * double(target.y1 - target.y0);
+    const double mean_area = overdraw * tile_area / double(triangles);  // (overdraw > 0: some triangle)
     return (overdraw - 1.0) * (overdraw - 1.0) * mean_area >= kDeferredMinUntexturedGain;
 }
 
