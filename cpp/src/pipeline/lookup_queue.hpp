@@ -52,8 +52,7 @@ public:
             int n = count_;
             for (; pixels && n < kLookupBatch; pixels &= pixels - 1, ++n) {
                 const int j = __builtin_ctz(pixels);
-                weights_.l0[n] = l0[j], weights_.l1[n] = l1[j], weights_.l2[n] = l2[j];
-                pending_[n] = {row_target + 4 * j, 1, current_, x0 + j, y};
+                put(n, row_target + 4 * j, 1, l0[j], l1[j], l2[j], x0 + j, y);
             }
             count_ = n;
             current_queued_ = true;
@@ -96,9 +95,13 @@ public:
     }
 
 private:
+    // Entry n of the queue: the current triangle's samples at `target`, screen weights l0, l1, l2.
+    void put(int n, float* target, std::uint64_t samples, double l0, double l1, double l2, int px, int py) {
+        weights_.l0[n] = l0, weights_.l1[n] = l1, weights_.l2[n] = l2;
+        pending_[n] = {target, samples, current_, px, py};
+    }
     void enqueue(float* target, std::uint64_t samples, double l0, double l1, double l2, int px, int py) {
-        weights_.l0[count_] = l0, weights_.l1[count_] = l1, weights_.l2[count_] = l2;
-        pending_[count_] = {target, samples, current_, px, py};
+        put(count_, target, samples, l0, l1, l2, px, py);
         current_queued_ = true;
         if (++count_ == kLookupBatch) flush();
     }

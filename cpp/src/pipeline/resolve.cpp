@@ -61,39 +61,38 @@ void resolve_tile(const SampleWindow& samples, int x0, int y0, int x1, int y1, R
         throw std::invalid_argument("resolve_tile: the " + to_string(filter) +
                                     " filter reads neighbouring pixels; use resolve_framebuffer");
     const int S = samples.samples;
-    const int n = x1 - x0;
-    // A power-of-two count divides by multiplying with its exact reciprocal (the same bits): four
-    // double divisions a pixel were most of the resolve. One sample is its own mean: a copy.
-    const auto resolve = [&](auto power_of_two) {
-        const double inverse = 1.0 / S;
+    // Every row of the rectangle through write_row, pixel(p) making a pixel of its S samples at p.
+    const auto each_row = [&](auto&& pixel) {
         for (int y = y0; y < y1; ++y) {
             const float* src = samples.at(x0, y, 0);
-            write_row(&out.at(x0, y, 0), n, [&](int i) {
-                const float* p = src + 4 * S * i;
-                // The sum in double: a float sum of samples near the float maximum would overflow
-                // to infinity, though their mean is finite.
-                double sum[4] = {0, 0, 0, 0};
-                for (int s = 0; s < S; ++s)
-                    for (int c = 0; c < 4; ++c) sum[c] += p[4 * s + c];
-                Rgba v;
-                for (int c = 0; c < 4; ++c) v[c] = static_cast<float>(power_of_two ? sum[c] * inverse : sum[c] / S);
-                return v;
-            });
+            write_row(&out.at(x0, y, 0), x1 - x0, [&](int i) { return pixel(src + 4 * S * i); });
         }
     };
+    // A power-of-two count divides by multiplying with its exact reciprocal (the same bits): four
+    // double divisions a pixel were most of the resolve. One sample is its own mean: a copy.
+    const auto mean = [&](auto power_of_two) {
+        const double inverse = 1.0 / S;
+        return [&, inverse, power_of_two](const float* p) {
+            // The sum in double: a float sum of samples near the float maximum would overflow to
+            // infinity, though their mean is finite.
+            double sum[4] = {0, 0, 0, 0};
+            for (int s = 0; s < S; ++s)
+                for (int c = 0; c < 4; ++c) sum[c] += p[4 * s + c];
+            Rgba v;
+            for (int c = 0; c < 4; ++c) v[c] = static_cast<float>(power_of_two ? sum[c] * inverse : sum[c] / S);
+            return v;
+        };
+    };
     if (S == 1) {
-        for (int y = y0; y < y1; ++y) {
-            const float* src = samples.at(x0, y, 0);
-            write_row(&out.at(x0, y, 0), n, [&](int i) {
-                Rgba v;
-                std::memcpy(&v, src + 4 * i, sizeof v);
-                return v;
-            });
-        }
+        each_row([](const float* p) {
+            Rgba v;
+            std::memcpy(&v, p, sizeof v);
+            return v;
+        });
     } else if ((S & (S - 1)) == 0) {
-        resolve(std::true_type{});
+        each_row(mean(std::true_type{}));
     } else {
-        resolve(std::false_type{});
+        each_row(mean(std::false_type{}));
     }
     finish_rows();
 }
