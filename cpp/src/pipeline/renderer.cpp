@@ -77,7 +77,7 @@ constexpr std::size_t kVertexRun = 512;
 
 // Triangles per chunk: enough chunks for load balance, few enough that per-chunk tile tables stay
 // small. The split never changes the output (see BinnedChunk).
-constexpr std::size_t kMinChunkTriangles = 4096;
+constexpr std::size_t kMinChunkTriangles = 256;
 
 void validate_draws(const std::vector<Draw>& draws) {
     for (std::size_t i = 0; i < draws.size(); ++i) {
