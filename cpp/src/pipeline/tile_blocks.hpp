@@ -42,18 +42,14 @@ struct SampleExtent {
 };
 
 /// Whether t covers no sample, some or all samples inside the extent. Edge values are affine, so
-/// their extremes over the extent are at its corners; exact in int64.
+/// their extremes over the extent are at the corners the signs of a and b pick; exact in int64.
 inline BlockCoverage block_coverage(const SetupTriangle& t, const SampleExtent& r) {
-    const std::int64_t X[2] = {r.X0, r.X1}, Y[2] = {r.Y0, r.Y1};
     bool all = true;
     for (int i = 0; i < 3; ++i) {
-        std::int64_t lo = std::numeric_limits<std::int64_t>::max(), hi = std::numeric_limits<std::int64_t>::min();
-        for (int corner = 0; corner < 4; ++corner) {
-            const std::int64_t e = t.edge_a[i] * X[corner & 1] + t.edge_b[i] * Y[corner >> 1] + t.edge_c[i];
-            lo = std::min(lo, e);
-            hi = std::max(hi, e);
-        }
+        const std::int64_t a = t.edge_a[i], b = t.edge_b[i];
+        const std::int64_t hi = a * (a >= 0 ? r.X1 : r.X0) + b * (b >= 0 ? r.Y1 : r.Y0) + t.edge_c[i];
         if (hi < 0) return BlockCoverage::none;
+        const std::int64_t lo = a * (a >= 0 ? r.X0 : r.X1) + b * (b >= 0 ? r.Y0 : r.Y1) + t.edge_c[i];
         if (lo < 0) all = false;
     }
     return all ? BlockCoverage::all : BlockCoverage::some;
@@ -120,9 +116,11 @@ public:
 
     /// The bits of the blocks that hold pixels of [x0, x1) × [y0, y1) (inside the target).
     std::uint32_t blocks_in(int x0, int y0, int x1, int y1) const {
+        const int column0 = (x0 >> kBlockShift) - bx0_, column1 = ((x1 - 1) >> kBlockShift) - bx0_;
+        const std::uint32_t row = (std::uint32_t{2} << column1) - (std::uint32_t{1} << column0);
         std::uint32_t bits = 0;
-        for (int y = y0; y < y1; y += kBlock - (y & (kBlock - 1)))
-            for (int x = x0; x < x1; x += kBlock - (x & (kBlock - 1))) bits |= std::uint32_t{1} << bit(x, y);
+        for (int r = (y0 >> kBlockShift) - by0_; r <= ((y1 - 1) >> kBlockShift) - by0_; ++r)
+            bits |= row << (r * kBlocksPerSide);
         return bits;
     }
 
@@ -213,14 +211,12 @@ private:
         else {
             if (coverage != BlockCoverage::all) return false;
             const std::uint32_t blocks = blocks_in(target_.x0, target_.y0, target_.x1, target_.y1);
-            float farthest = 0.0f;  // over every block of the target
-            for (std::uint32_t m = blocks; m; m &= m - 1) {
-                known_farthest<kDepth>(m & -m);
-                const float f = farthest_[__builtin_ctz(m)];
-                if (m == blocks || (kDepth == DepthFunc::greater ? f < farthest : f > farthest)) farthest = f;
-            }
             const float nearest = nearest_depth<kDepth>(t, r);
-            if (!(kDepth == DepthFunc::greater ? nearest <= farthest : nearest >= farthest)) return false;
+            for (std::uint32_t m = blocks; m; m &= m - 1) {  // hidden behind every block's farthest depth
+                known_farthest<kDepth>(m & -m);
+                const float farthest = farthest_[__builtin_ctz(m)];
+                if (!(kDepth == DepthFunc::greater ? nearest <= farthest : nearest >= farthest)) return false;
+            }
             out.skipped = blocks;
             out.skipped_samples = static_cast<std::uint64_t>(target_.x1 - target_.x0) *
                                   static_cast<std::uint64_t>(target_.y1 - target_.y0) * static_cast<std::uint64_t>(S);
