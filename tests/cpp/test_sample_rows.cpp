@@ -6,11 +6,15 @@
 // 2^52, where the rows fall back to the per-sample path.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "helpers.hpp"
+#include "mipraster/pipeline/interpolate.hpp"
+#include "pipeline/sample_row.hpp"  // (internal: the two vector widths side by side)
 
 namespace {
 
@@ -123,6 +127,104 @@ TEST(SampleRows, TrianglesWithEdgeValuesPast2To52GiveThePerSampleBits) {
     auto s = settings(W, H, 1);
     s.threads = 1;
     expect_same_with_and_without_rows({make_draw(big, glm::dmat4(1.0), state)}, cam, s);
+}
+
+// The row test itself, on random triangles, rows, stored depths and masks, against the per-sample
+// arithmetic written out here (exact integer edge values, screen_weights, sample_depth, a strict
+// test): both vector widths give its coverage, outcomes, weights and stored depths bit for bit,
+// and both refuse the rows whose edge values reach 2^52. Without AVX2 only the SSE2 path runs.
+TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
+    const bool avx2 = __builtin_cpu_supports("avx2");
+    const mr::Viewport viewport{96, 80, mr::DepthConvention::reverse_z};
+    std::mt19937_64 rng(61);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const auto bits = [](auto x) {
+        std::uint64_t b = 0;
+        std::memcpy(&b, &x, sizeof x);
+        return b;
+    };
+    long rows = 0, refused = 0, passed_pixels = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        // Every other triangle has its vertices on pixel centres, so that its edges run through
+        // samples (the top-left rule decides those).
+        std::array<mr::ScreenVertex, 3> v;
+        for (auto& vertex : v) {
+            const int px = static_cast<int>(rng() % 120) - 12, py = static_cast<int>(rng() % 104) - 12;
+            const int jitter = trial % 2 ? static_cast<int>(rng() % 256) - 128 : 0;
+            vertex = {px * mr::kSubpixelOne + 128 + jitter, py * mr::kSubpixelOne + 128 - jitter,
+                      static_cast<float>(0.3 + 2.0 * unit(rng)), true, unit(rng)};
+        }
+        mr::SetupTriangle t;
+        mr::SetupCounters counters;
+        if (!mr::setup_triangle(v, viewport, mr::CullMode::none, t, counters)) continue;
+        const int y = t.min_y + static_cast<int>(rng() % static_cast<unsigned>(t.max_y - t.min_y + 1));
+        const int x0 = t.min_x - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_x - t.min_x + 3));
+        const int n = 1 + static_cast<int>(rng() % mr::kTileSize);
+        std::int64_t e[3];
+        const std::int64_t X = std::int64_t{x0} * mr::kSubpixelOne + 128, Y = std::int64_t{y} * mr::kSubpixelOne + 128;
+        for (int i = 0; i < 3; ++i) e[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+        if (trial % 50 == 0) e[trial % 3] += (std::int64_t{1} << 52) * (trial % 100 == 0 ? 1 : -1);  // refused
+        const std::uint32_t tested = static_cast<std::uint32_t>(rng());
+        const mr::DepthFunc func = rng() % 2 ? mr::DepthFunc::greater : mr::DepthFunc::less;
+        const bool depth_write = rng() % 2;
+
+        // The per-sample reference, pixel by pixel.
+        bool exact = true;
+        for (int i = 0; i < 3; ++i)
+            for (std::int64_t v : {e[i] + t.bias[i], e[i] + t.bias[i] + std::int64_t{t.edge_a[i]} * mr::kSubpixelOne * (n - 1)})
+                exact = exact && std::abs(v) < (std::int64_t{1} << 52);
+        float stored[mr::kTileSize], want_depth[mr::kTileSize];
+        std::uint32_t want_covered = 0, want_passed = 0;
+        double want_l[3][mr::kTileSize] = {};
+        for (int j = 0; j < n; ++j) {
+            const std::int64_t E[3] = {e[0] + std::int64_t{t.edge_a[0]} * mr::kSubpixelOne * j,
+                                       e[1] + std::int64_t{t.edge_a[1]} * mr::kSubpixelOne * j,
+                                       e[2] + std::int64_t{t.edge_a[2]} * mr::kSubpixelOne * j};
+            const glm::dvec3 l = mr::screen_weights(t, E[0], E[1], E[2]);
+            const float z = mr::sample_depth(t, l);
+            const int kind = static_cast<int>(rng() % 4);  // a tie, a random depth, or either end
+            stored[j] = kind == 0 ? z : kind == 1 ? float(unit(rng)) : kind == 2 ? 0.0f : 1.0f;
+            want_depth[j] = stored[j];
+            if ((E[0] | E[1] | E[2]) < 0) continue;
+            want_covered |= 1u << j;
+            const bool wins = func == mr::DepthFunc::greater ? z > stored[j] : z < stored[j];
+            if (!(tested >> j & 1) || !wins) continue;
+            want_passed |= 1u << j;
+            want_l[0][j] = l.x, want_l[1][j] = l.y, want_l[2][j] = l.z;
+            if (depth_write) want_depth[j] = z;
+        }
+
+        const auto check = [&](const char* path, auto row_test) {
+            float depth[mr::kTileSize];
+            std::copy(stored, stored + n, depth);
+            mr::kernels::SampleRow out;
+            const bool ran = row_test(t, e, n, tested, func, depth_write, depth, out);
+            ASSERT_EQ(ran, exact) << path << " trial " << trial;
+            if (!ran) {
+                for (int j = 0; j < n; ++j) ASSERT_EQ(bits(depth[j]), bits(stored[j])) << path << " touched a refused row";
+                return;
+            }
+            ASSERT_EQ(out.covered, want_covered) << path << " trial " << trial;
+            ASSERT_EQ(out.passed, want_passed) << path << " trial " << trial;
+            for (int j = 0; j < n; ++j) {
+                ASSERT_EQ(bits(depth[j]), bits(want_depth[j])) << path << " trial " << trial << " pixel " << j;
+                if (!(want_passed >> j & 1)) continue;
+                ASSERT_EQ(bits(out.l0[j]), bits(want_l[0][j])) << path << " trial " << trial << " pixel " << j;
+                ASSERT_EQ(bits(out.l1[j]), bits(want_l[1][j])) << path << " trial " << trial << " pixel " << j;
+                ASSERT_EQ(bits(out.l2[j]), bits(want_l[2][j])) << path << " trial " << trial << " pixel " << j;
+            }
+        };
+        check("sse2", mr::kernels::test_sample_row_sse2);
+        if (avx2) check("avx2", mr::kernels::test_sample_row_avx2);
+        ++rows;
+        refused += !exact;
+        passed_pixels += __builtin_popcount(want_passed);
+    }
+    std::cout << "rows " << rows << " (refused " << refused << "), passed pixels " << passed_pixels
+              << (avx2 ? "" : "; this CPU has no AVX2: only the SSE2 path ran") << "\n";
+    EXPECT_GE(rows, 15000);
+    EXPECT_GE(refused, 200);
+    EXPECT_GE(passed_pixels, 12000);
 }
 
 }  // namespace

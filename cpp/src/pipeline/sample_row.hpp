@@ -1,6 +1,6 @@
 #pragma once
 // One triangle along one row of one-sample pixels (private to the pipeline): coverage, screen
-// weights and the depth test, four pixels per double vector. Each value is the tile kernel's
+// weights and the depth test, four pixels at a time in double vectors. Each value is the tile kernel's
 // per-sample arithmetic on the same numbers in the same order (no fused multiply-add), so the
 // coverage, weights, depths and test outcomes are the per-sample path's bits.
 #include <cstdint>
@@ -30,6 +30,13 @@ struct SampleRow {
 /// row reaches 2^52 in magnitude (its sums in double could round): the per-sample path then runs.
 bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested, DepthFunc func,
                      bool depth_write, float* depth, SampleRow& out);
+
+/// test_sample_row on two doubles per vector (SSE2, every x86-64 CPU) and on four (AVX2, only where
+/// the CPU has it): the same bits. test_sample_row takes the widest the CPU has.
+bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested,
+                          DepthFunc func, bool depth_write, float* depth, SampleRow& out);
+bool test_sample_row_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested,
+                          DepthFunc func, bool depth_write, float* depth, SampleRow& out);
 
 /// The screen weights of pixels j < n of a row whose first pixel's sample has edge values e (bias
 /// not added), into l_i[j] (room for n rounded up to even): screen_weights' bits. False, touching
