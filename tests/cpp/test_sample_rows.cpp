@@ -151,7 +151,8 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
         for (auto& vertex : v) {
             const int px = static_cast<int>(rng() % 120) - 12, py = static_cast<int>(rng() % 104) - 12;
             const int jitter = trial % 2 ? static_cast<int>(rng() % 256) - 128 : 0;
-            vertex = {px * mr::kSubpixelOne + 128 + jitter, py * mr::kSubpixelOne + 128 - jitter,
+            vertex = {static_cast<std::int32_t>(px * mr::kSubpixelOne + 128 + jitter),
+                      static_cast<std::int32_t>(py * mr::kSubpixelOne + 128 - jitter),
                       static_cast<float>(0.3 + 2.0 * unit(rng)), true, unit(rng)};
         }
         mr::SetupTriangle t;
@@ -198,6 +199,7 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
             float depth[mr::kTileSize];
             std::copy(stored, stored + n, depth);
             mr::kernels::SampleRow out;
+            for (double* l : {out.l0, out.l1, out.l2}) std::fill(l, l + mr::kTileSize, std::nan(""));
             const bool ran = row_test(t, e, n, tested, func, depth_write, depth, out);
             ASSERT_EQ(ran, exact) << path << " trial " << trial;
             if (!ran) {
