@@ -285,6 +285,43 @@ TEST(Interpolate, VertexValuesRangeIsGlmsMinAndMax) {
     }
 }
 
+// VertexValues::interpolate (four components at once) against its definition per component,
+// std::clamp(float(w.x·v0 + w.y·v1 + w.z·v2), lo, hi), bit for bit: weights inside and outside
+// [0, 1] (so that the clamp acts at both ends), values of large and mixed magnitudes (so that the
+// order of the sum shows), ±0, ±∞ and NaN.
+TEST(Interpolate, VertexValuesInterpolateIsTheClampedWeightedSum) {
+    const float special[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 3e15f, -3e15f, 1e-40f,
+                             std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()};
+    std::mt19937 rng(16);
+    std::uniform_int_distribution<int> pick(0, 9);
+    std::uniform_real_distribution<double> weight(-0.5, 1.5), value(-2.0, 2.0);
+    const auto bits = [](float x) {
+        std::uint32_t b;
+        std::memcpy(&b, &x, 4);
+        return b;
+    };
+    int clamped_low = 0, clamped_high = 0;
+    for (int trial = 0; trial < 100000; ++trial) {
+        glm::vec4 v[3];
+        for (auto& x : v)
+            for (int k = 0; k < 4; ++k)
+                x[k] = trial % 4 ? float(value(rng)) * (trial % 3 ? 1.0f : 1e15f) : special[pick(rng)];
+        const mr::VertexValues values(v[0], v[1], v[2]);
+        const double w0 = weight(rng), w1 = weight(rng);
+        const glm::dvec3 w(w0, w1, trial % 2 ? 1.0 - w0 - w1 : weight(rng));
+        const glm::vec4 got = values.interpolate(w);
+        for (int k = 0; k < 4; ++k) {
+            const float sum = static_cast<float>(w.x * v[0][k] + w.y * v[1][k] + w.z * v[2][k]);
+            const float want = std::clamp(sum, values.lo[k], values.hi[k]);
+            clamped_low += sum < values.lo[k];
+            clamped_high += values.hi[k] < sum;
+            ASSERT_EQ(bits(got[k]), bits(want)) << "trial " << trial << " component " << k;
+        }
+    }
+    EXPECT_GE(clamped_low, 10000);
+    EXPECT_GE(clamped_high, 10000);
+}
+
 TEST(Interpolate, InterpolatedValuesStayWithinTheVertexValuesRange) {
     // Extreme depth ratio (1e-1 … 1e4) and colours spanning a tiny range near 1 and a range
     // crossing zero: every interpolated value stays within [min, max] of its vertices.

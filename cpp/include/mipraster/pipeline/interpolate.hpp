@@ -74,11 +74,24 @@ struct VertexValues {
         std::memcpy(&hi, &high, sizeof hi);
     }
 
-    /// Σ w_i·v_i, clamped to the vertex values' range so rounding never leaves it.
+    /// Σ w_i·v_i, clamped to the vertex values' range so rounding never leaves it: per component,
+    /// std::clamp(float(w.x·v0 + w.y·v1 + w.z·v2), lo, hi), four components at once.
     glm::vec4 interpolate(const glm::dvec3& w) const {
+        typedef float Four __attribute__((vector_size(16)));
+        typedef double FourDoubles __attribute__((vector_size(32)));
+        Four a, b, c, low, high;
+        std::memcpy(&a, &v[0], sizeof a);
+        std::memcpy(&b, &v[1], sizeof b);
+        std::memcpy(&c, &v[2], sizeof c);
+        std::memcpy(&low, &lo, sizeof low);
+        std::memcpy(&high, &hi, sizeof high);
+        const FourDoubles a2 = __builtin_convertvector(a, FourDoubles), b2 = __builtin_convertvector(b, FourDoubles),
+                          c2 = __builtin_convertvector(c, FourDoubles);
+        const FourDoubles sum = w.x * a2 + w.y * b2 + w.z * c2;
+        const Four x = __builtin_convertvector(sum, Four);
+        const Four clamped = x < low ? low : (high < x ? high : x);
         glm::vec4 r;
-        for (int c = 0; c < 4; ++c)
-            r[c] = std::clamp(static_cast<float>(w.x * v[0][c] + w.y * v[1][c] + w.z * v[2][c]), lo[c], hi[c]);
+        std::memcpy(&r, &clamped, sizeof r);
         return r;
     }
 };
