@@ -172,8 +172,10 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
         // The per-sample reference, pixel by pixel.
         bool exact = true;
         for (int i = 0; i < 3; ++i)
-            for (std::int64_t v : {e[i] + t.bias[i], e[i] + t.bias[i] + std::int64_t{t.edge_a[i]} * mr::kSubpixelOne * (n - 1)})
+            for (int j : {0, n - 1}) {
+                const std::int64_t v = e[i] + t.bias[i] + std::int64_t{t.edge_a[i]} * mr::kSubpixelOne * j;
                 exact = exact && std::abs(v) < (std::int64_t{1} << 52);
+            }
         float stored[mr::kTileSize], want_depth[mr::kTileSize];
         std::uint32_t want_covered = 0, want_passed = 0;
         double want_l[3][mr::kTileSize] = {};
@@ -203,7 +205,8 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
             const bool ran = row_test(t, e, n, tested, func, depth_write, depth, out);
             ASSERT_EQ(ran, exact) << path << " trial " << trial;
             if (!ran) {
-                for (int j = 0; j < n; ++j) ASSERT_EQ(bits(depth[j]), bits(stored[j])) << path << " touched a refused row";
+                for (int j = 0; j < n; ++j)
+                    ASSERT_EQ(bits(depth[j]), bits(stored[j])) << path << " touched a refused row";
                 return;
             }
             ASSERT_EQ(out.covered, want_covered) << path << " trial " << trial;

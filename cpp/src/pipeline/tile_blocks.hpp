@@ -252,7 +252,9 @@ private:
     template <DepthFunc kDepth>
     float farthest_stored(int b) const {
         typedef float Four __attribute__((vector_size(16)));
-        const auto farther = [](auto a, auto b) { return kDepth == DepthFunc::greater ? (b < a ? b : a) : (b > a ? b : a); };
+        const auto farther = [](auto a, auto b) {
+            return kDepth == DepthFunc::greater ? (b < a ? b : a) : (b > a ? b : a);
+        };
         const int bx = bx0_ + b % kBlocksPerSide, by = by0_ + b / kBlocksPerSide;
         const SampleWindow& depth = target_.depth;
         const int x0 = std::max(target_.x0, bx << kBlockShift), x1 = std::min(target_.x1, (bx + 1) << kBlockShift);
