@@ -38,4 +38,9 @@ texel::Texel anisotropic_line(const TextureLevel& level, const Sampler& sampler,
 texel::Texel anisotropic_line_avx2(const TextureLevel& level, const Sampler& sampler, double u, double v, double du,
                                    double dv, int count);
 
+/// anisotropic_line_avx2 on two levels at once (a lookup that blends them): the same bits as two
+/// calls, the two lines' sums side by side so that their chains of additions overlap.
+void anisotropic_lines_avx2(const TextureLevel& a, const TextureLevel& b, const Sampler& sampler, double u, double v,
+                            double du, double dv, int count, texel::Texel& mean_a, texel::Texel& mean_b);
+
 }  // namespace mipraster

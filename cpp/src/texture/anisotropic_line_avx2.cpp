@@ -71,6 +71,12 @@ struct Probes {
     }
 }
 
+// Probe c's bilinear quad.
+[[gnu::target("avx2")]] inline Texel quad(const glm::vec4* t, const Probes& p, int c) {
+    return lerp_quad(load(t[p.texel[0][c]]), load(t[p.texel[1][c]]), load(t[p.texel[2][c]]), load(t[p.texel[3][c]]),
+                     p.fx[c], p.fy[c]);
+}
+
 [[gnu::target("avx2")]] Texel line_mean(const TextureLevel& level, const ProbeLine& g, int count, const Sampler& s) {
     const glm::vec4* t = level.texels.data();
     Probes p;
@@ -78,15 +84,44 @@ struct Probes {
     for (int k0 = 0; k0 < count; k0 += kChunk) {
         const int n = std::min(kChunk, count - k0);
         place(g, k0, n, level.width, level.height, !g.inside, s, p);
-        const auto quad = [&](int c) {
-            return lerp_quad(load(t[p.texel[0][c]]), load(t[p.texel[1][c]]), load(t[p.texel[2][c]]),
-                             load(t[p.texel[3][c]]), p.fx[c], p.fy[c]);
-        };
         int c = 0;
-        if (k0 == 0) first = quad(c++);
-        for (; c < n; ++c) difference += quad(c) - first;
+        if (k0 == 0) first = quad(t, p, c++);
+        for (; c < n; ++c) difference += quad(t, p, c) - first;
     }
     return first + difference * splat(static_cast<float>(g.step));
+}
+
+// line_mean on two levels at once: each sum in its own probe order (the same bits), the two
+// chains of additions side by side so that they overlap.
+[[gnu::target("avx2")]] void line_means(const TextureLevel& a, const ProbeLine& ga, const TextureLevel& b,
+                                        const ProbeLine& gb, int count, const Sampler& s, Texel& mean_a,
+                                        Texel& mean_b) {
+    const glm::vec4 *ta = a.texels.data(), *tb = b.texels.data();
+    Probes pa, pb;
+    Texel first_a = splat(0.0f), difference_a = splat(0.0f), first_b = splat(0.0f), difference_b = splat(0.0f);
+    for (int k0 = 0; k0 < count; k0 += kChunk) {
+        const int n = std::min(kChunk, count - k0);
+        place(ga, k0, n, a.width, a.height, !ga.inside, s, pa);
+        place(gb, k0, n, b.width, b.height, !gb.inside, s, pb);
+        int c = 0;
+        if (k0 == 0) {
+            first_a = quad(ta, pa, 0);
+            first_b = quad(tb, pb, 0);
+            c = 1;
+        }
+        for (; c < n; ++c) {
+            difference_a += quad(ta, pa, c) - first_a;
+            difference_b += quad(tb, pb, c) - first_b;
+        }
+    }
+    mean_a = first_a + difference_a * splat(static_cast<float>(ga.step));
+    mean_b = first_b + difference_b * splat(static_cast<float>(gb.step));
+}
+
+// Whether line_mean takes g on `level` (else the reference does: too far out for int indices, or
+// a level whose texel indices overflow an int).
+bool vectors_reach(const ProbeLine& g, const TextureLevel& level) {
+    return g.near && level.texels.size() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
 }
 
 }  // namespace
@@ -94,10 +129,16 @@ struct Probes {
 [[gnu::target("avx2")]] Texel anisotropic_line_avx2(const TextureLevel& level, const Sampler& s, double u, double v,
                                                      double du, double dv, int count) {
     const ProbeLine g = probe_line(level, s, u, v, du, dv, count);
-    // Too far out for int indices, or on a level whose texel indices overflow an int: the reference.
-    if (!g.near || level.texels.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
-        return anisotropic_line(level, s, u, v, du, dv, count);
-    return line_mean(level, g, count, s);
+    return vectors_reach(g, level) ? line_mean(level, g, count, s) : anisotropic_line(level, s, u, v, du, dv, count);
+}
+
+[[gnu::target("avx2")]] void anisotropic_lines_avx2(const TextureLevel& a, const TextureLevel& b, const Sampler& s,
+                                                    double u, double v, double du, double dv, int count, Texel& mean_a,
+                                                    Texel& mean_b) {
+    const ProbeLine ga = probe_line(a, s, u, v, du, dv, count), gb = probe_line(b, s, u, v, du, dv, count);
+    if (vectors_reach(ga, a) && vectors_reach(gb, b)) return line_means(a, ga, b, gb, count, s, mean_a, mean_b);
+    mean_a = anisotropic_line_avx2(a, s, u, v, du, dv, count);
+    mean_b = anisotropic_line_avx2(b, s, u, v, du, dv, count);
 }
 
 #else  // (other CPUs never call it: BatchSampler uses it only where AVX2 is)
@@ -105,6 +146,12 @@ struct Probes {
 Texel anisotropic_line_avx2(const TextureLevel& level, const Sampler& s, double u, double v, double du, double dv,
                             int count) {
     return anisotropic_line(level, s, u, v, du, dv, count);
+}
+
+void anisotropic_lines_avx2(const TextureLevel& a, const TextureLevel& b, const Sampler& s, double u, double v,
+                            double du, double dv, int count, Texel& mean_a, Texel& mean_b) {
+    mean_a = anisotropic_line(a, s, u, v, du, dv, count);
+    mean_b = anisotropic_line(b, s, u, v, du, dv, count);
 }
 
 #endif

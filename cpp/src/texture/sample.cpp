@@ -224,6 +224,12 @@ const std::array<double, kMostProbes + 1> kLog2Count = [] {
     for (int n = 1; n <= kMostProbes; ++n) table[n] = std::log2(double(n));
     return table;
 }();
+// 1/N for every probe count N: the same division, out of each lookup's chain of dependent steps.
+const std::array<double, kMostProbes + 1> kInverseCount = [] {
+    std::array<double, kMostProbes + 1> table{};
+    for (int n = 1; n <= kMostProbes; ++n) table[n] = 1.0 / n;
+    return table;
+}();
 
 }  // namespace
 
@@ -274,7 +280,7 @@ ProbeLine probe_line(const TextureLevel& level, const Sampler& s, double u, doub
     const double cx = periodic(s.wrap_u) ? reduce(u * level.width, level.width, s.wrap_u) : u * level.width;
     const double cy = periodic(s.wrap_v) ? reduce(v * level.height, level.height, s.wrap_v) : v * level.height;
     ProbeLine line;
-    line.step = 1.0 / count;
+    line.step = count >= 1 && count <= kMostProbes ? kInverseCount[static_cast<std::size_t>(count)] : 1.0 / count;
     line.sx = du * level.width, line.sy = dv * level.height;
     line.x0 = cx - 0.5 + (0.5 * line.step - 0.5) * line.sx, line.y0 = cy - 0.5 + (0.5 * line.step - 0.5) * line.sy;
     const double x1 = line.x0 + (count - 1) * line.step * line.sx, y1 = line.y0 + (count - 1) * line.step * line.sy;
