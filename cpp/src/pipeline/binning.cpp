@@ -52,17 +52,28 @@ double clipped_area(const SetupTriangle& t, int x0, int y0, int x1, int y1) {
     return std::abs(twice_area) / (2.0 * kOne * kOne);
 }
 
+// The share of its bounding box t fills, times the part [bx0, bx1) × [by0, by1) of the box.
+inline double box_share(const SetupTriangle& t, int bx0, int by0, int bx1, int by1) {
+    constexpr double kPixelArea2 = 2.0 * double(kSubpixelOne) * double(kSubpixelOne);  // 2A units per px²
+    const double box = double(t.max_x + 1 - t.min_x) * double(t.max_y + 1 - t.min_y);
+    const double fill = std::min(1.0, 1.0 / (t.inv_area2 * kPixelArea2 * box));
+    return double(bx1 - bx0) * double(by1 - by0) * fill;
+}
+
+// A bounding box strictly inside the rectangle holds the vertices (bounds are the floors of their
+// positions, and a clamp to the viewport lands on the rectangle's edge), so t covers some of it
+// and not all: only a box reaching an edge needs the corner tests.
+inline bool box_inside(const SetupTriangle& t, int x0, int y0, int x1, int y1) {
+    return t.min_x > x0 && t.max_x + 1 < x1 && t.min_y > y0 && t.max_y + 1 < y1;
+}
+
 }  // namespace
 
 double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1) {
     const int bx0 = std::max(t.min_x, x0), bx1 = std::min(t.max_x + 1, x1);
     const int by0 = std::max(t.min_y, y0), by1 = std::min(t.max_y + 1, y1);
     if (bx0 >= bx1 || by0 >= by1) return 0.0;
-    // A bounding box strictly inside the rectangle holds the vertices (bounds are the floors of
-    // their positions, and a clamp to the viewport lands on the rectangle's edge), so t covers
-    // some of it and not all: only a box reaching an edge needs the corner tests.
-    const bool inside = t.min_x > x0 && t.max_x + 1 < x1 && t.min_y > y0 && t.max_y + 1 < y1;
-    if (!inside) {
+    if (!box_inside(t, x0, y0, x1, y1)) {
         const kernels::SampleExtent extent{std::int64_t{x0} * kSubpixelOne, std::int64_t{y0} * kSubpixelOne,
                                            std::int64_t{x1} * kSubpixelOne - 1, std::int64_t{y1} * kSubpixelOne - 1};
         const kernels::BlockCoverage coverage = kernels::block_coverage(t, extent);
@@ -72,10 +83,7 @@ double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1)
         // little (clamped to the viewport, it can be smaller than the triangle), so clip.
         if (t.max_x + 1 - t.min_x > kTileSize || t.max_y + 1 - t.min_y > kTileSize) return clipped_area(t, x0, y0, x1, y1);
     }
-    constexpr double kPixelArea2 = 2.0 * double(kSubpixelOne) * double(kSubpixelOne);  // 2A units per px²
-    const double box = double(t.max_x + 1 - t.min_x) * double(t.max_y + 1 - t.min_y);
-    const double fill = std::min(1.0, 1.0 / (t.inv_area2 * kPixelArea2 * box));
-    return double(bx1 - bx0) * double(by1 - by0) * fill;
+    return box_share(t, bx0, by0, bx1, by1);
 }
 
 void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas) {
@@ -92,8 +100,11 @@ void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas)
             ++chunk.tile_start[static_cast<std::size_t>(tile) + 1];
             if (!overlap_areas) return;
             const int x0 = tx * kTileSize, y0 = ty * kTileSize;
-            chunk.tile_area[static_cast<std::size_t>(tile)] += tile_overlap_area(
-                t, x0, y0, std::min(x0 + kTileSize, grid.width), std::min(y0 + kTileSize, grid.height));
+            const int x1 = std::min(x0 + kTileSize, grid.width), y1 = std::min(y0 + kTileSize, grid.height);
+            // (Most small triangles lie inside one tile: tile_overlap_area's first case, inline.)
+            chunk.tile_area[static_cast<std::size_t>(tile)] +=
+                box_inside(t, x0, y0, x1, y1) ? box_share(t, t.min_x, t.min_y, t.max_x + 1, t.max_y + 1)
+                                              : tile_overlap_area(t, x0, y0, x1, y1);
         });
     for (std::size_t i = 1; i < chunk.tile_start.size(); ++i) chunk.tile_start[i] += chunk.tile_start[i - 1];
     reserve_on_huge_pages(chunk.tile_triangles, chunk.tile_start.back());
