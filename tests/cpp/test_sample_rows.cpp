@@ -1,15 +1,18 @@
-// Sample rows (RenderSettings::sample_rows): at one sample per pixel, a depth-tested triangle's
-// coverage, screen weights and depth tests along a row run four pixels per vector. Colour, depth
-// and every counter are bit for bit those of the per-sample path — for both depth conventions,
-// every blend and interpolation, textured or not, depth written or only read, with and without
-// block skipping and deferred shading — including triangles whose edge values along a row pass
-// 2^52, where the rows fall back to the per-sample path.
+// Sample rows (RenderSettings::sample_rows): at one sample per pixel or SSAA, a depth-tested
+// triangle's coverage, screen weights and depth tests along a row run four pixels per vector
+// (sample by sample under SSAA). Colour, depth and every counter are bit for bit those of the
+// per-sample path — for both depth conventions, every blend and interpolation, textured or not,
+// depth written or only read, with and without block skipping and deferred shading — including
+// triangles whose edge values along a row pass 2^52, where the rows fall back to the per-sample
+// path.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "helpers.hpp"
@@ -56,13 +59,21 @@ TEST(SampleRows, SameBitsAndCountersAsThePerSamplePathOnOverlappingScenes) {
                     draws[0].texture = texture;
                     draws[3].state.interpolation = mr::Interpolation::flat;
                     draws[4].mesh = &b;
-                    SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(blend) + ", " +
-                                 mr::to_string(interpolation) + (skipping ? ", block skipping" : ""));
-                    auto s = settings(W, H, 1);
-                    s.threads = 1;
-                    s.block_skipping = skipping;
-                    s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
-                    expect_same_with_and_without_rows(draws, cam, s);
+                    // One sample per pixel, and SSAA (rows sample by sample), with sample counts
+                    // that fill vectors of four and counts that do not.
+                    for (const auto& [samples, pattern] : {std::pair{1, mr::PatternKind::automatic},
+                                                           std::pair{4, mr::PatternKind::rotated},
+                                                           std::pair{6, mr::PatternKind::stratified}}) {
+                        SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(blend) + ", " +
+                                     mr::to_string(interpolation) + (skipping ? ", block skipping" : "") + ", " +
+                                     std::to_string(samples) + " samples");
+                        auto s = settings(W, H, samples, pattern);
+                        s.anti_aliasing = mr::AntiAliasing::ssaa;
+                        s.threads = 1;
+                        s.block_skipping = skipping;
+                        s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+                        expect_same_with_and_without_rows(draws, cam, s);
+                    }
                 }
     }
 }
@@ -124,15 +135,18 @@ TEST(SampleRows, TrianglesWithEdgeValuesPast2To52GiveThePerSampleBits) {
     }
     mr::DrawState state;
     state.interpolation = mr::Interpolation::screen;
-    auto s = settings(W, H, 1);
-    s.threads = 1;
-    expect_same_with_and_without_rows({make_draw(big, glm::dmat4(1.0), state)}, cam, s);
+    for (int samples : {1, 4}) {  // (SSAA: a row falls back whole when any sample's row would round)
+        auto s = settings(W, H, samples);
+        s.threads = 1;
+        expect_same_with_and_without_rows({make_draw(big, glm::dmat4(1.0), state)}, cam, s);
+    }
 }
 
-// The row test itself, on random triangles, rows, stored depths and masks, against the per-sample
-// arithmetic written out here (exact integer edge values, screen_weights, sample_depth, a strict
-// test): both vector widths give its coverage, outcomes, weights and stored depths bit for bit,
-// and both refuse the rows whose edge values reach 2^52. Without AVX2 only the SSE2 path runs.
+// The row test itself, on random triangles, rows, stored depths and masks, with depths one float
+// apart (one sample per pixel) or S apart (SSAA), against the per-sample arithmetic written out
+// here (exact integer edge values, screen_weights, sample_depth, a strict test): both vector
+// widths give its coverage, outcomes, weights and stored depths bit for bit, touch no other
+// sample, and refuse the rows whose edge values reach 2^52. Without AVX2 only the SSE2 path runs.
 TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
     const bool avx2 = __builtin_cpu_supports("avx2");
     const mr::Viewport viewport{96, 80, mr::DepthConvention::reverse_z};
@@ -143,7 +157,7 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
         std::memcpy(&b, &x, sizeof x);
         return b;
     };
-    long rows = 0, refused = 0, passed_pixels = 0;
+    long rows = 0, refused = 0, passed_pixels = 0, near_bound = 0;
     for (int trial = 0; trial < 20000; ++trial) {
         // Every other triangle has its vertices on pixel centres, so that its edges run through
         // samples (the top-left rule decides those).
@@ -165,9 +179,13 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
         const std::int64_t X = std::int64_t{x0} * mr::kSubpixelOne + 128, Y = std::int64_t{y} * mr::kSubpixelOne + 128;
         for (int i = 0; i < 3; ++i) e[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
         if (trial % 50 == 0) e[trial % 3] += (std::int64_t{1} << 52) * (trial % 100 == 0 ? 1 : -1);  // refused
+        if (trial % 50 == 25)  // 2^50 to 2^52 + 2^50: taken whole or not, refused or not
+            e[trial % 3] += ((std::int64_t{1} << 50) + static_cast<std::int64_t>(rng() % (std::uint64_t{1} << 52))) *
+                            (trial % 100 == 25 ? 1 : -1);
         const std::uint32_t tested = static_cast<std::uint32_t>(rng());
         const mr::DepthFunc func = rng() % 2 ? mr::DepthFunc::greater : mr::DepthFunc::less;
         const bool depth_write = rng() % 2;
+        const int stride = std::array<int, 4>{1, 1, 4, 5}[trial % 4];  // one sample per pixel, or one of S
 
         // The per-sample reference, pixel by pixel.
         bool exact = true;
@@ -176,6 +194,15 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
                 const std::int64_t v = e[i] + t.bias[i] + std::int64_t{t.edge_a[i]} * mr::kSubpixelOne * j;
                 exact = exact && std::abs(v) < (std::int64_t{1} << 52);
             }
+        // The kernel's test for a whole row, at the pixel corners: it promises every sample's row,
+        // any offset from the corner (here the centre's) is taken.
+        const std::int64_t corner[3] = {e[0] - 128 * std::int64_t{t.edge_a[0] + t.edge_b[0]},
+                                        e[1] - 128 * std::int64_t{t.edge_a[1] + t.edge_b[1]},
+                                        e[2] - 128 * std::int64_t{t.edge_a[2] + t.edge_b[2]}};
+        if (mr::kernels::sample_rows_exact(t, corner, n)) {
+            ASSERT_TRUE(exact) << "trial " << trial;
+            near_bound += trial % 50 == 25;
+        }
         float stored[mr::kTileSize], want_depth[mr::kTileSize];
         std::uint32_t want_covered = 0, want_passed = 0;
         double want_l[3][mr::kTileSize] = {};
@@ -198,21 +225,26 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
         }
 
         const auto check = [&](const char* path, auto row_test) {
-            float depth[mr::kTileSize];
-            std::copy(stored, stored + n, depth);
+            // The row's depths `stride` apart; the samples between them (−1, never a depth here)
+            // must stay as they are.
+            std::vector<float> depth(static_cast<std::size_t>(n * stride), -1.0f);
+            for (int j = 0; j < n; ++j) depth[static_cast<std::size_t>(j * stride)] = stored[j];
+            const std::vector<float> before = depth;
             mr::kernels::SampleRow out;
             for (double* l : {out.l0, out.l1, out.l2}) std::fill(l, l + mr::kTileSize, std::nan(""));
-            const bool ran = row_test(t, e, n, tested, func, depth_write, depth, out);
+            const bool ran = row_test(t, e, n, tested, func, depth_write, depth.data(), stride, out);
             ASSERT_EQ(ran, exact) << path << " trial " << trial;
-            if (!ran) {
-                for (int j = 0; j < n; ++j)
-                    ASSERT_EQ(bits(depth[j]), bits(stored[j])) << path << " touched a refused row";
-                return;
+            for (std::size_t k = 0; k < depth.size(); ++k) {
+                if (!ran || k % static_cast<std::size_t>(stride) != 0) {
+                    ASSERT_EQ(bits(depth[k]), bits(before[k])) << path << " trial " << trial << " touched " << k;
+                }
             }
+            if (!ran) return;
             ASSERT_EQ(out.covered, want_covered) << path << " trial " << trial;
             ASSERT_EQ(out.passed, want_passed) << path << " trial " << trial;
             for (int j = 0; j < n; ++j) {
-                ASSERT_EQ(bits(depth[j]), bits(want_depth[j])) << path << " trial " << trial << " pixel " << j;
+                ASSERT_EQ(bits(depth[static_cast<std::size_t>(j * stride)]), bits(want_depth[j]))
+                    << path << " trial " << trial << " stride " << stride << " pixel " << j;
                 if (!(want_passed >> j & 1)) continue;
                 ASSERT_EQ(bits(out.l0[j]), bits(want_l[0][j])) << path << " trial " << trial << " pixel " << j;
                 ASSERT_EQ(bits(out.l1[j]), bits(want_l[1][j])) << path << " trial " << trial << " pixel " << j;
@@ -226,9 +258,11 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
         passed_pixels += __builtin_popcount(want_passed);
     }
     std::cout << "rows " << rows << " (refused " << refused << "), passed pixels " << passed_pixels
+              << ", rows taken whole near 2^51 " << near_bound
               << (avx2 ? "" : "; this CPU has no AVX2: only the SSE2 path ran") << "\n";
     EXPECT_GE(rows, 15000);
     EXPECT_GE(refused, 200);
+    EXPECT_GE(near_bound, 40);
     EXPECT_GE(passed_pixels, 12000);
 }
 

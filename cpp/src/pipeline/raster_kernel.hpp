@@ -128,9 +128,9 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
         };
 
-        // The passed pixels of a one-sample row (bit j: pixel rx0 + j) at once, as passed_sample takes
+        // The passed pixels of a row's sample s (bit j: pixel rx0 + j) at once, as passed_sample takes
         // them one by one: for queued lookups and the deferred pre-pass's owners (false: neither).
-        const auto passed_row = [&](int rx0, int py, const SampleRow& row) {
+        const auto passed_row = [&](int rx0, int py, int s, const SampleRow& row) {
             if constexpr (kShading == Shading::visibility) {
                 if (!target.owners) return false;
             } else if (!queue) {
@@ -140,11 +140,11 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             const auto passed = static_cast<std::uint64_t>(count_bits(row.passed));
             counters.samples_passed += passed;
             if constexpr (kShading == Shading::visibility) {
-                std::int32_t* const owners = target.owners + target.owner_index(rx0, py, 0, 1);
-                for (std::uint32_t m = row.passed; m; m &= m - 1) owners[__builtin_ctz(m)] = owner;
+                std::int32_t* const owners = target.owners + target.owner_index(rx0, py, s, S);
+                for (std::uint32_t m = row.passed; m; m &= m - 1) owners[__builtin_ctz(m) * S] = owner;
             } else {
                 counters.shader_invocations += passed;
-                queue->push_row(color_out.at(rx0, py, 0), row.passed, row.l0, row.l1, row.l2, rx0, py);
+                queue->push_row(color_out.at(rx0, py, s), 4 * S, row.passed, row.l0, row.l1, row.l2, rx0, py);
             }
             return true;
         };
@@ -160,23 +160,32 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             const std::int64_t row2 = t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2];
             const int n = rx1 - rx0;
 
-            // One sample per pixel, depth tested: the row four pixels at a time (sample_row.hpp).
-            if constexpr (kMode == SampleMode::single && kDepth != DepthFunc::none) {
-                if (target.sample_rows && n >= kSampleRowMinPixels) {
+            // Depth tested, every sample shaded (one per pixel, or SSAA): the row four pixels at a
+            // time, sample by sample (sample_row.hpp). With several samples, only where none of
+            // their rows can be refused; one sample's refused row takes the per-sample path.
+            if constexpr (kMode != SampleMode::msaa && kDepth != DepthFunc::none) {
+                bool rows = target.sample_rows && n >= kSampleRowMinPixels &&
+                            (kMode == SampleMode::single || sample_rows_exact(t, {row0, row1, row2}, n));
+                if (rows) {
                     const std::uint32_t skipped = blocks.row_pixels(cls.skipped, py, rx0, n);
                     const std::uint32_t untested = skipped | blocks.row_pixels(cls.hidden, py, rx0, n);
-                    const std::int64_t e[3] = {row0 + off0[0], row1 + off1[0], row2 + off2[0]};
-                    SampleRow row;
-                    if (test_sample_row(t, e, n, ~untested, kDepth, draw.depth_write, depth_out.at(rx0, py, 0), row)) {
+                    for (int s = 0; s < S; ++s) {
+                        const std::int64_t e[3] = {row0 + off0[s], row1 + off1[s], row2 + off2[s]};
+                        SampleRow row;
+                        if (!test_sample_row(t, e, n, ~untested, kDepth, draw.depth_write, depth_out.at(rx0, py, s), S,
+                                             row)) {
+                            rows = false;  // (one sample, nothing done yet)
+                            break;
+                        }
                         counters.samples_covered += static_cast<std::uint64_t>(count_bits(row.covered & ~skipped));
                         if constexpr (kShading == Shading::visibility || kTexturing != Texturing::none)
-                            if (passed_row(rx0, py, row)) continue;
+                            if (passed_row(rx0, py, s, row)) continue;
                         for (std::uint32_t m = row.passed; m; m &= m - 1) {
                             const int j = __builtin_ctz(m);
-                            passed_sample(rx0 + j, py, 0, glm::dvec3(row.l0[j], row.l1[j], row.l2[j]));
+                            passed_sample(rx0 + j, py, s, glm::dvec3(row.l0[j], row.l1[j], row.l2[j]));
                         }
-                        continue;
                     }
+                    if (rows) continue;
                 }
             }
 
@@ -337,7 +346,8 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
                     const int n = end - px;
                     if (queue) {  // the run as one mask
                         counters.shader_invocations += static_cast<std::uint64_t>(n);
-                        queue->push_row(target.color.at(px, py, 0), ~std::uint32_t{0} >> (32 - n), l0, l1, l2, px, py);
+                        queue->push_row(target.color.at(px, py, 0), 4, ~std::uint32_t{0} >> (32 - n), l0, l1, l2, px,
+                                        py);
                     } else {
                         for (int j = 0; j < n; ++j) shade_sample(px + j, py, 0, glm::dvec3(l0[j], l1[j], l2[j]));
                     }

@@ -7,18 +7,30 @@ namespace kernels {
 
 namespace {
 
-// |x| < 2^52: every integer between two such values, and their sums with the row's steps, is a
-// double, so the sums below are exact.
-inline bool small(std::int64_t x) { return x > -(std::int64_t{1} << 52) && x < (std::int64_t{1} << 52); }
-
-// Whether e_i + bias_i stays below 2^52 in magnitude along the n pixels of the row.
-bool exact_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n) {
+// Whether e_i + bias_i stays below `bound` in magnitude at the first and last of the n pixels.
+bool row_within(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::int64_t bound) {
     for (int i = 0; i < 3; ++i) {
-        const std::int64_t first = e[i] + t.bias[i];
-        if (!small(first) || !small(first + std::int64_t{t.edge_a[i]} * kSubpixelOne * (n - 1))) return false;
+        const std::int64_t first = e[i] + t.bias[i], last = first + std::int64_t{t.edge_a[i]} * kSubpixelOne * (n - 1);
+        if (!(first > -bound && first < bound && last > -bound && last < bound)) return false;
     }
     return true;
 }
+
+// Below 2^52 every integer between two such values, and their sums with the row's steps, is a
+// double, so the sums below are exact.
+inline bool exact_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n) {
+    return row_within(t, e, n, std::int64_t{1} << 52);
+}
+
+}  // namespace
+
+bool sample_rows_exact(const SetupTriangle& t, const std::int64_t (&corner)[3], int n) {
+    // A sample's offset from its pixel's corner moves an edge value by less than 2^40 (|a|, |b| <
+    // 2^31, offsets < 256): from 2^51 at the corners no sample's row reaches 2^52.
+    return row_within(t, corner, n, std::int64_t{1} << 51);
+}
+
+namespace {
 
 // The row's edge values plus bias, e_i + bias_i + j·step_i at pixel j, two pixels per register:
 // the per-sample path converts each to double; here the first is converted once and the steps
@@ -37,12 +49,28 @@ struct RowEdges {
     }
 };
 
+// The stored depths of `lanes` ≤ 4 pixels `stride` floats apart. A short group or a stride is
+// built in registers (scalar stores then a vector load would wait for store forwarding).
+inline __m128 stored_depths(const float* p, int stride, int lanes) {
+    if (lanes == 4 && stride == 1) return _mm_loadu_ps(p);
+    return _mm_setr_ps(p[0], lanes > 1 ? p[stride] : 0.0f, lanes > 2 ? p[2 * stride] : 0.0f,
+                       lanes > 3 ? p[3 * stride] : 0.0f);
+}
+
+// Stores the depths of the passed lanes (bits of `passed`, the lanes where `wins` is set).
+inline void store_depths(float* p, int stride, int lanes, std::uint32_t passed, __m128 wins, __m128 depths, __m128 s) {
+    if (lanes == 4 && stride == 1) return _mm_storeu_ps(p, _mm_or_ps(_mm_and_ps(wins, depths), _mm_andnot_ps(wins, s)));
+    alignas(16) float z[4];
+    _mm_store_ps(z, depths);
+    for (std::uint32_t m = passed; m; m &= m - 1) p[__builtin_ctz(m) * stride] = z[__builtin_ctz(m)];
+}
+
 }  // namespace
 
 // SSE2 (the x86-64 baseline): two doubles per register. Each product and sum is rounded on its
 // own, as in the per-sample path (intrinsics are never contracted).
 bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested,
-                          DepthFunc func, bool depth_write, float* depth, SampleRow& out) {
+                          DepthFunc func, bool depth_write, float* depth, int stride, SampleRow& out) {
     if (!exact_row(t, e, n)) return false;
     const RowEdges edges(t, e);
     __m128d bias[3];
@@ -75,11 +103,8 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         const __m128 asked = _mm_and_ps(
             covered, _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(tested >> j)), lane_bit), lane_bit)));
         if (!(_mm_movemask_ps(asked) & in_row)) continue;
-        // The row's last group may be short: built in registers (scalar stores then a vector load
-        // would wait for store forwarding).
-        float* const stored = depth + j;
-        const __m128 s = lanes == 4 ? _mm_loadu_ps(stored)
-                                    : _mm_setr_ps(stored[0], lanes > 1 ? stored[1] : 0.0f, lanes > 2 ? stored[2] : 0.0f, 0.0f);
+        float* const stored = depth + j * stride;
+        const __m128 s = stored_depths(stored, stride, lanes);
         const __m128 wins = _mm_and_ps(asked, greater ? _mm_cmpgt_ps(depths, s) : _mm_cmplt_ps(depths, s));
         const std::uint32_t passed = static_cast<std::uint32_t>(_mm_movemask_ps(wins)) & in_row;
         if (!passed) continue;
@@ -89,13 +114,7 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
             _mm_storeu_pd(out.l1 + j + 2 * h, l1[h]);
             _mm_storeu_pd(out.l2 + j + 2 * h, l2[h]);
         }
-        if (depth_write && lanes == 4) {
-            _mm_storeu_ps(stored, _mm_or_ps(_mm_and_ps(wins, depths), _mm_andnot_ps(wins, s)));
-        } else if (depth_write) {
-            if (passed & 1) stored[0] = _mm_cvtss_f32(depths);
-            if (passed & 2) stored[1] = _mm_cvtss_f32(_mm_shuffle_ps(depths, depths, 1));
-            if (passed & 4) stored[2] = _mm_cvtss_f32(_mm_shuffle_ps(depths, depths, 2));
-        }
+        if (depth_write) store_depths(stored, stride, lanes, passed, wins, depths, s);
     }
     return true;
 }
@@ -104,7 +123,7 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
 // same bits; the depth test and stores are the SSE2 path's.
 [[gnu::target("avx2")]] bool test_sample_row_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], int n,
                                                   std::uint32_t tested, DepthFunc func, bool depth_write, float* depth,
-                                                  SampleRow& out) {
+                                                  int stride, SampleRow& out) {
     if (!exact_row(t, e, n)) return false;
     __m256d first[3], step[3], bias[3];
     for (int i = 0; i < 3; ++i) {
@@ -133,9 +152,8 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         out.covered |= covered << j;
         const std::uint32_t asked = covered & (tested >> j);
         if (!asked) continue;
-        float* const stored = depth + j;
-        const __m128 s = lanes == 4 ? _mm_loadu_ps(stored)
-                                    : _mm_setr_ps(stored[0], lanes > 1 ? stored[1] : 0.0f, lanes > 2 ? stored[2] : 0.0f, 0.0f);
+        float* const stored = depth + j * stride;
+        const __m128 s = stored_depths(stored, stride, lanes);
         const std::uint32_t passed =
             static_cast<std::uint32_t>(_mm_movemask_ps(greater ? _mm_cmpgt_ps(depths, s) : _mm_cmplt_ps(depths, s))) &
             asked;
@@ -144,15 +162,11 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         _mm256_storeu_pd(out.l0 + j, l0);
         _mm256_storeu_pd(out.l1 + j, l1);
         _mm256_storeu_pd(out.l2 + j, l2);
-        if (depth_write && lanes == 4) {
+        if (depth_write) {
             const __m128 wins = _mm_castsi128_ps(_mm_cmpgt_epi32(
                 _mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(passed)), _mm_setr_epi32(1, 2, 4, 8)),
                 _mm_setzero_si128()));
-            _mm_storeu_ps(stored, _mm_blendv_ps(s, depths, wins));
-        } else if (depth_write) {
-            if (passed & 1) stored[0] = _mm_cvtss_f32(depths);
-            if (passed & 2) stored[1] = _mm_cvtss_f32(_mm_shuffle_ps(depths, depths, 1));
-            if (passed & 4) stored[2] = _mm_cvtss_f32(_mm_shuffle_ps(depths, depths, 2));
+            store_depths(stored, stride, lanes, passed, wins, depths, s);
         }
     }
     return true;
@@ -163,8 +177,9 @@ const bool kHasAvx2 = __builtin_cpu_supports("avx2");
 }
 
 bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested, DepthFunc func,
-                     bool depth_write, float* depth, SampleRow& out) {
-    return (kHasAvx2 ? test_sample_row_avx2 : test_sample_row_sse2)(t, e, n, tested, func, depth_write, depth, out);
+                     bool depth_write, float* depth, int stride, SampleRow& out) {
+    return (kHasAvx2 ? test_sample_row_avx2 : test_sample_row_sse2)(t, e, n, tested, func, depth_write, depth, stride,
+                                                                   out);
 }
 
 bool sample_row_weights(const SetupTriangle& t, const std::int64_t (&e)[3], int n, double* l0, double* l1, double* l2) {

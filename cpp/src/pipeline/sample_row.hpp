@@ -1,5 +1,5 @@
 #pragma once
-// One triangle along one row of one-sample pixels (private to the pipeline): coverage, screen
+// One triangle along one sample of each pixel of a row (private to the pipeline): coverage, screen
 // weights and the depth test, four pixels at a time in double vectors. Each value is the tile kernel's
 // per-sample arithmetic on the same numbers in the same order (no fused multiply-add), so the
 // coverage, weights, depths and test outcomes are the per-sample path's bits.
@@ -24,19 +24,24 @@ struct SampleRow {
     double l0[kTileSize], l1[kTileSize], l2[kTileSize];  ///< screen weights where passed
 };
 
-/// Triangle t over pixels j < n of a row whose first pixel's sample has edge values e (bias not
-/// added). Tests depth (less or greater) at the pixels of `tested` against depth[j], storing the
-/// passing depths when depth_write. Returns false, touching nothing, when an edge value along the
-/// row reaches 2^52 in magnitude (its sums in double could round): the per-sample path then runs.
+/// Whether test_sample_row takes the row of every sample of pixels j < n whose first pixel's
+/// corner has edge values `corner` (bias not added): true only where no sample's row is refused.
+bool sample_rows_exact(const SetupTriangle& t, const std::int64_t (&corner)[3], int n);
+
+/// Triangle t over one sample of pixels j < n of a row, whose first pixel's sample has edge values
+/// e (bias not added). Tests depth (less or greater) at the pixels of `tested` against
+/// depth[j·stride] (stride: the pixels' samples), storing the passing depths when depth_write.
+/// Returns false, touching nothing, when an edge value along the row reaches 2^52 in magnitude
+/// (its sums in double could round): the per-sample path then runs.
 bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested, DepthFunc func,
-                     bool depth_write, float* depth, SampleRow& out);
+                     bool depth_write, float* depth, int stride, SampleRow& out);
 
 /// test_sample_row on two doubles per vector (SSE2, every x86-64 CPU) and on four (AVX2, only where
 /// the CPU has it): the same bits. test_sample_row takes the widest the CPU has.
 bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested,
-                          DepthFunc func, bool depth_write, float* depth, SampleRow& out);
+                          DepthFunc func, bool depth_write, float* depth, int stride, SampleRow& out);
 bool test_sample_row_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested,
-                          DepthFunc func, bool depth_write, float* depth, SampleRow& out);
+                          DepthFunc func, bool depth_write, float* depth, int stride, SampleRow& out);
 
 /// The screen weights of pixels j < n of a row whose first pixel's sample has edge values e (bias
 /// not added), into l_i[j] (room for n rounded up to even): screen_weights' bits. False, touching

@@ -59,9 +59,9 @@ struct RenderSettings {
     /// where it lies behind every depth already stored (they would all fail). The output and the
     /// sample counters are the same either way; false runs the plain per-sample path, for comparison.
     bool block_skipping = true;
-    /// At one sample per pixel, a depth-tested triangle's coverage, weights and depth tests along
-    /// a row of pixels run four pixels per vector; the output and counters are the same bits
-    /// either way; false runs the per-sample path, for comparison.
+    /// At one sample per pixel and under SSAA, a depth-tested triangle's coverage, weights and
+    /// depth tests along a row of pixels run four pixels per vector (sample by sample); the output
+    /// and counters are the same bits either way; false runs the per-sample path, for comparison.
     bool sample_rows = true;
     /// Where a tile's triangles overlap kDeferredMinOverdraw deep or more and every draw blends by
     /// replacing (at 1 sample or SSAA), shade only the samples that stay visible: a pre-pass
