@@ -22,16 +22,6 @@ inline bool exact_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n)
     return row_within(t, e, n, std::int64_t{1} << 52);
 }
 
-}  // namespace
-
-bool sample_rows_exact(const SetupTriangle& t, const std::int64_t (&corner)[3], int n) {
-    // A sample's offset from its pixel's corner moves an edge value by less than 2^40 (|a|, |b| <
-    // 2^31, offsets < 256): from 2^51 at the corners no sample's row reaches 2^52.
-    return row_within(t, corner, n, std::int64_t{1} << 51);
-}
-
-namespace {
-
 // The row's edge values plus bias, e_i + bias_i + j·step_i at pixel j, two pixels per register:
 // the per-sample path converts each to double; here the first is converted once and the steps
 // added, the same integers exactly while exact_row holds.
@@ -66,6 +56,12 @@ inline void store_depths(float* p, int stride, int lanes, std::uint32_t passed, 
 }
 
 }  // namespace
+
+bool sample_rows_exact(const SetupTriangle& t, const std::int64_t (&corner)[3], int n) {
+    // A sample's offset from its pixel's corner moves an edge value by less than 2^40 (|a|, |b| <
+    // 2^31, offsets < 256): from 2^51 at the corners no sample's row reaches 2^52.
+    return row_within(t, corner, n, std::int64_t{1} << 51);
+}
 
 // SSE2 (the x86-64 baseline): two doubles per register. Each product and sum is rounded on its
 // own, as in the per-sample path (intrinsics are never contracted).

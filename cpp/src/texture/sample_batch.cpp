@@ -352,16 +352,16 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
             const auto line = [&](int k) {
                 return line_mean(texture_.level(k), s, b.u[l], b.v[l], du, dv, lines.count[l]);
             };
-            const int k = plan.level[l];
+            const int fine = plan.level[l];
             Texel c;
             if (plan.level_weight[l] > 0.0f && vector_width_ == 8) {  // both levels' lines side by side
                 Texel finer, coarser;
-                anisotropic_lines_avx2(texture_.level(k), texture_.level(k + 1), s, b.u[l], b.v[l], du, dv,
+                anisotropic_lines_avx2(texture_.level(fine), texture_.level(fine + 1), s, b.u[l], b.v[l], du, dv,
                                        lines.count[l], finer, coarser);
                 c = lerp(finer, coarser, plan.level_weight[l]);
             } else {
-                c = line(k);
-                if (plan.level_weight[l] > 0.0f) c = lerp(c, line(k + 1), plan.level_weight[l]);
+                c = line(fine);
+                if (plan.level_weight[l] > 0.0f) c = lerp(c, line(fine + 1), plan.level_weight[l]);
             }
             out[l] = to_vec4(c);
             continue;
