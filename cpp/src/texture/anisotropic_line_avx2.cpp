@@ -124,12 +124,17 @@ bool vectors_reach(const ProbeLine& g, const TextureLevel& level) {
     return g.near && level.texels.size() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
 }
 
+// The line g of the lookup (u, v, du, dv) on `level`: line_mean where it reaches, else the reference.
+[[gnu::target("avx2")]] Texel line_or_reference(const TextureLevel& level, const ProbeLine& g, const Sampler& s,
+                                                double u, double v, double du, double dv, int count) {
+    return vectors_reach(g, level) ? line_mean(level, g, count, s) : anisotropic_line(level, s, u, v, du, dv, count);
+}
+
 }  // namespace
 
 [[gnu::target("avx2")]] Texel anisotropic_line_avx2(const TextureLevel& level, const Sampler& s, double u, double v,
                                                      double du, double dv, int count) {
-    const ProbeLine g = probe_line(level, s, u, v, du, dv, count);
-    return vectors_reach(g, level) ? line_mean(level, g, count, s) : anisotropic_line(level, s, u, v, du, dv, count);
+    return line_or_reference(level, probe_line(level, s, u, v, du, dv, count), s, u, v, du, dv, count);
 }
 
 [[gnu::target("avx2")]] void anisotropic_lines_avx2(const TextureLevel& a, const TextureLevel& b, const Sampler& s,
@@ -137,8 +142,8 @@ bool vectors_reach(const ProbeLine& g, const TextureLevel& level) {
                                                     Texel& mean_b) {
     const ProbeLine ga = probe_line(a, s, u, v, du, dv, count), gb = probe_line(b, s, u, v, du, dv, count);
     if (vectors_reach(ga, a) && vectors_reach(gb, b)) return line_means(a, ga, b, gb, count, s, mean_a, mean_b);
-    mean_a = anisotropic_line_avx2(a, s, u, v, du, dv, count);
-    mean_b = anisotropic_line_avx2(b, s, u, v, du, dv, count);
+    mean_a = line_or_reference(a, ga, s, u, v, du, dv, count);  // (the lines already placed, not again)
+    mean_b = line_or_reference(b, gb, s, u, v, du, dv, count);
 }
 
 #else  // (other CPUs never call it: BatchSampler uses it only where AVX2 is)
