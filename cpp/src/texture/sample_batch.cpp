@@ -53,11 +53,21 @@ template <typename To, typename From>
 [[gnu::always_inline]] inline To convert(From x) {  // float → int truncates
     return __builtin_convertvector(x, To);
 }
-// ⌊x⌋ of |x| < 2³¹ (callers bound x first): truncate, then step down where that rounded up.
+// ⌊x⌋ of |x| < 2³¹ (callers bound x first), as a float: eight lanes by AVX's rounding
+// instruction (exact; written as assembly because the always-inline helpers are not compiled for
+// AVX, the function they are inlined into is), four by truncating, then stepping down where that
+// rounded up. The same value either way.
 template <typename Ints, typename Floats>
-[[gnu::always_inline]] inline Ints floor_v(Floats x) {
+[[gnu::always_inline]] inline Floats floor_v(Floats x) {
+#if defined(__x86_64__)
+    if constexpr (sizeof(Floats) == 32) {
+        Floats whole;
+        asm("vroundps $9, %1, %0" : "=x"(whole) : "x"(x));  // 9: towards −∞, no inexact exception
+        return whole;
+    }
+#endif
     const Ints i = convert<Ints>(x);
-    return i + (convert<Floats>(i) > x);  // a true compare is −1
+    return convert<Floats>(i + (convert<Floats>(i) > x));  // a true compare is −1
 }
 template <typename To, typename From>
 [[gnu::always_inline]] inline To bits_as(From x) {
@@ -122,7 +132,7 @@ template <int W>
     if (mode != WrapMode::repeat) return coordinate;
     const Ints whole_number = (coordinate >= splat<Floats>(0x1p23f)) | (coordinate <= splat<Floats>(-0x1p23f));
     const Floats bounded = whole_number ? splat<Floats>(0.0f) : coordinate;
-    return bounded - convert<Floats>(floor_v<Ints>(bounded));
+    return bounded - floor_v<Ints>(bounded);
 }
 
 // Texel indices and fractions along one axis at level sizes n (float and int, per lane), for a
@@ -133,8 +143,9 @@ template <int W>
                                         typename Lanes<W>::Ints& hi, typename Lanes<W>::Floats& fraction) {
     MIPRASTER_LANES(W);
     const Floats x = mode == WrapMode::repeat ? reduced * n - 0.5f : clamp_v(reduced * n, splat<Floats>(-2.0f), n + 2.0f) - 0.5f;
-    const Ints i = floor_v<Ints>(x);
-    fraction = x - convert<Floats>(i);
+    const Floats whole = floor_v<Ints>(x);
+    const Ints i = convert<Ints>(whole);
+    fraction = x - whole;
     if (mode == WrapMode::repeat) {
         lo = i < 0 ? i + n_int : i;
         hi = i + 1 >= n_int ? i + 1 - n_int : i + 1;
@@ -176,7 +187,7 @@ template <int W>
         Floats log2_rho = 0.5f * log2_v<W>(max_v(rho2, splat<Floats>(kTiny)));
         log2_rho = rho2 < splat<Floats>(kTiny) ? splat<Floats>(-std::numeric_limits<float>::infinity()) : log2_rho;
         lambda = clamp_v(log2_rho + s.lod_bias, splat<Floats>(-1.0f), splat<Floats>(static_cast<float>(levels)));
-        const Floats nearest_integer = convert<Floats>(floor_v<Ints>(lambda + 0.5f));
+        const Floats nearest_integer = floor_v<Ints>(lambda + 0.5f);
         const Floats distance = lambda - nearest_integer;
         lambda = (distance < splat<Floats>(1e-6f)) & (distance > splat<Floats>(-1e-6f)) ? nearest_integer : lambda;
         lambda = clamp_v(lambda, splat<Floats>(s.min_lod), splat<Floats>(s.max_lod));
