@@ -49,7 +49,12 @@ ground truths are in :mod:`mipraster.reference` and its scenes in :mod:`mipraste
 returns a :class:`CompareReport`; :mod:`mipraster.testing` (imported explicitly) builds golden-image
 tests on it.
 """
-from ._core import (
+from ._build_info import X86_LEVEL as _X86_LEVEL
+from ._cpu import check_cpu as _check_cpu
+
+_check_cpu(_X86_LEVEL)  # before the compiled modules load: see _cpu.py
+
+from ._core import (  # noqa: E402
     MemoryLimitError,
     kept_buffer_bytes,
     linear_to_srgb,

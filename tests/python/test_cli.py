@@ -237,3 +237,22 @@ def test_texture_options_on_an_untextured_scene_warn(tmp_path):
     assert "no textured draw" in r.stderr
     quiet = run("render", str(obj), "-o", str(tmp_path / "tri.png"), "--size", "32x32", "--filter", "ewa", "--quiet")
     assert quiet.returncode == 0 and quiet.stderr == ""
+
+
+@pytest.mark.parametrize("cpu", ["Nehalem", "Haswell"])
+def test_an_older_cpu_gets_a_message_not_an_illegal_instruction(cpu):
+    # The command under qemu's user-mode emulation of an older CPU (Nehalem: SSE4.2, no AVX) and of
+    # the first with x86-64-v3 (Haswell). A build for v3 refuses the older one by name, before any
+    # of its code runs; a baseline build runs on both.
+    from mipraster import _build_info
+
+    qemu = shutil.which("qemu-x86_64")
+    assert qemu, "qemu-x86_64 is not installed (Debian's qemu-user; .ci/dev test installs it)"
+    r = subprocess.run([qemu, "-cpu", cpu, EXE, "--help"], capture_output=True, text=True, timeout=300)
+    if _build_info.X86_LEVEL == "v3" and cpu == "Nehalem":
+        assert r.returncode == 2
+        assert "compiled for x86-64-v3 (AVX2), which this CPU does not have" in r.stderr
+        assert "-DMIPRASTER_X86_LEVEL=baseline" in r.stderr
+    else:
+        assert r.returncode == 0, r.stderr
+        assert "usage: mipraster" in r.stdout + r.stderr

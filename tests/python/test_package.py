@@ -85,3 +85,38 @@ def test_public_api_is_documented():
 
 def test_version():
     assert mr.__version__ == "0.1.0"
+
+
+# --- the instruction set the modules were compiled for (CMake's MIPRASTER_X86_LEVEL) --------------
+
+V3_FLAGS = "fpu sse2 avx avx2 bmi1 bmi2 f16c fma movbe abm"
+
+
+def test_the_build_names_an_instruction_set_this_cpu_runs():
+    from mipraster import _build_info, _cpu
+
+    assert _build_info.X86_LEVEL in ("baseline", "v3")
+    flags = _cpu.cpu_flags()
+    if flags is not None:  # (Linux) import mipraster got here, so the check passed
+        assert _cpu.missing_features(_build_info.X86_LEVEL, flags) == []
+
+
+@pytest.mark.parametrize("drop, named", [("avx2", "avx2"), ("bmi2", "bmi2"), ("movbe", "movbe"), ("abm", "lzcnt")])
+def test_a_v3_build_on_a_cpu_without_a_v3_feature_is_refused_by_name(tmp_path, drop, named):
+    from mipraster import _cpu
+
+    cpuinfo = tmp_path / "cpuinfo"
+    cpuinfo.write_text("processor\t: 0\nflags\t\t: " + " ".join(f for f in V3_FLAGS.split() if f != drop) + "\n")
+    with pytest.raises(ImportError, match=rf"x86-64-v3.*missing: {named}\).*MIPRASTER_X86_LEVEL=baseline"):
+        _cpu.check_cpu("v3", str(cpuinfo))
+    _cpu.check_cpu("baseline", str(cpuinfo))  # a baseline build runs anywhere
+
+
+def test_a_v3_build_on_a_v3_cpu_loads():
+    from mipraster import _cpu
+
+    assert _cpu.missing_features("v3", V3_FLAGS.split()) == []
+    assert _cpu.missing_features("v3", V3_FLAGS.replace("abm", "lzcnt").split()) == []
+    assert _cpu.check_cpu("v3", "/nonexistent/cpuinfo") is None  # no flags to read: the modules decide
+    with pytest.raises(ValueError, match="unknown x86-64 level 'v4'"):
+        _cpu.missing_features("v4", [])
