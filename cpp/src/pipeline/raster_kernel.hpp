@@ -195,6 +195,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             // measured faster for the 1–3 pixel rows of small triangles than a shift-based vector form.
             // The first sample stores each mask, the others add their bit: no clearing pass first,
             // whose string stores the next loads would wait for (16 % of the kernel on small triangles).
+            // One sample per pixel needs no masks: the pixel loop tests its edge values itself.
             std::uint64_t mask[kTileSize];
             const auto row_samples = [&](int s, auto&& store) {  // store(j, 1 if sample s of pixel j is inside)
                 std::int64_t e0 = row0 + off0[s], e1 = row1 + off1[s], e2 = row2 + off2[s];
@@ -205,11 +206,16 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     e2 += step2;
                 }
             };
-            row_samples(0, [&](int j, std::uint64_t inside) { mask[j] = inside; });
-            for (int s = 1; s < S; ++s) row_samples(s, [&](int j, std::uint64_t inside) { mask[j] |= inside << s; });
+            if constexpr (kMode != SampleMode::single) {
+                row_samples(0, [&](int j, std::uint64_t inside) { mask[j] = inside; });
+                for (int s = 1; s < S; ++s) row_samples(s, [&](int j, std::uint64_t inside) { mask[j] |= inside << s; });
+            }
 
             for (int j = 0; j < n; ++j) {
-                std::uint64_t covered = mask[j];
+                const std::int64_t p0 = row0 + j * step0, p1 = row1 + j * step1, p2 = row2 + j * step2;
+                std::uint64_t covered = kMode == SampleMode::single
+                                            ? static_cast<std::uint64_t>(((p0 + off0[0]) | (p1 + off1[0]) | (p2 + off2[0])) >= 0)
+                                            : mask[j];
                 if (!covered) continue;
                 const int px = rx0 + j;
                 if (classified && (classified >> blocks.bit(px, py) & 1)) {  // counted, not tested
@@ -217,7 +223,6 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         counters.samples_covered += static_cast<std::uint64_t>(count_bits(covered));
                     continue;
                 }
-                const std::int64_t p0 = row0 + j * step0, p1 = row1 + j * step1, p2 = row2 + j * step2;
                 float* const depth_px = kDepth != DepthFunc::none ? depth_out.at(px, py, 0) : nullptr;
 
                 if constexpr (kMode == SampleMode::msaa) {
