@@ -63,6 +63,11 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
 
     for (std::size_t k = 0; k < batch.count; ++k) {
         const SetupTriangle& t = batch.tris[batch.indices[k]];
+        if (k + 4 < batch.count) {  // a set-up record (two cache lines) four triangles ahead: small
+            const char* ahead = reinterpret_cast<const char*>(&batch.tris[batch.indices[k + 4]]);
+            __builtin_prefetch(ahead);  // triangles take less time each than it takes from memory
+            __builtin_prefetch(ahead + 64);
+        }
         const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
         const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
         if (x0 >= x1 || y0 >= y1) continue;
