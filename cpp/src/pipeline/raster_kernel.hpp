@@ -63,9 +63,11 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
 
     for (std::size_t k = 0; k < batch.count; ++k) {
         const SetupTriangle& t = batch.tris[batch.indices[k]];
-        if (k + 4 < batch.count) {  // a set-up record (two cache lines) four triangles ahead: small
+        // The set-up record (two cache lines) of the triangle four ahead: a small triangle takes
+        // less time than its record takes to come from memory.
+        if (k + 4 < batch.count) {
             const char* ahead = reinterpret_cast<const char*>(&batch.tris[batch.indices[k + 4]]);
-            __builtin_prefetch(ahead);  // triangles take less time each than it takes from memory
+            __builtin_prefetch(ahead);
             __builtin_prefetch(ahead + 64);
         }
         const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
@@ -194,15 +196,15 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 }
             }
 
-            // Coverage masks of the row: sample s of pixel j is inside iff all three edge values are
-            // ≥ 0, i.e. the sign bit of their OR is clear. For MSAA, and SSAA rows as long as sample
-            // rows take (which get here without a depth test), in a pass of their own: plain integer
-            // adds, which vectorize with 64-bit compares (x86-64-v3; on the baseline it stays scalar).
-            // The first sample stores each mask, the others add their bit: no clearing pass first,
-            // whose string stores the next loads would wait for. Shorter rows, and every row at one
-            // sample a pixel, skip the pass: the pixel loop tests its samples itself, which measured
-            // faster for small triangles (many_small 1x raster 86.5 -> 68.7 ms, SSAA 4x -5 %) and
-            // slower for long MSAA rows (plane MSAA 4x +5 %).
+            // Coverage of the row's samples: sample s of pixel j is inside iff all three edge values
+            // are ≥ 0, i.e. the sign bit of their OR is clear. MSAA rows, and SSAA rows of
+            // kSampleRowMinPixels or more (here only without a depth test or past sample_rows_exact),
+            // get their masks in a pass of their own: plain integer adds, which vectorize with 64-bit
+            // compares (x86-64-v3; scalar on the baseline). The first sample stores each mask, the
+            // others add their bit: no clearing pass first, whose string stores the next loads would
+            // wait for. The other rows (all of them at one sample a pixel) test each pixel's samples
+            // in the pixel loop: faster for small triangles (many_small 1x raster 86.5 -> 68.7 ms,
+            // SSAA 4x -5 %), slower for long MSAA rows (plane MSAA 4x +5 %).
             const bool masks = kMode == SampleMode::msaa || (kMode == SampleMode::ssaa && n >= kSampleRowMinPixels);
             std::uint64_t mask[kTileSize];
             const auto row_samples = [&](int s, auto&& store) {  // store(j, 1 if sample s of pixel j is inside)

@@ -54,9 +54,9 @@ template <typename To, typename From>
     return __builtin_convertvector(x, To);
 }
 // ⌊x⌋ of |x| < 2³¹ (callers bound x first), as a float: eight lanes by AVX's rounding
-// instruction (exact; written as assembly because the always-inline helpers are not compiled for
-// AVX, the function they are inlined into is), four by truncating, then stepping down where that
-// rounded up. The same value either way.
+// instruction (exact), four by truncating, then stepping down where that rounded up. The same
+// value either way. Assembly, because in a baseline build these always-inline helpers are not
+// compiled for AVX (only the function they end up in is), and the intrinsic would be refused.
 template <typename Ints, typename Floats>
 [[gnu::always_inline]] inline Floats floor_v(Floats x) {
 #if defined(__x86_64__)
