@@ -339,18 +339,18 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     LanePlan plan;
     (vector_width_ == 8 ? plan_avx2 : plan_sse2)(b, lines.rho2_scale, n, s, texture_.width(), texture_.height(), levels,
                                                  plan);
-    // Lanes spread over more than four rows of texels (a surface whose texture runs across the
-    // screen's rows) read texels the hardware prefetcher cannot foresee: all quads' rows are asked
-    // for first, so that the misses overlap instead of each lane waiting for its own.
+    // Lanes spread over more than one row of texels (a surface whose texture runs across the
+    // screen's rows) read texels the hardware prefetcher cannot foresee: the rows of all quads on
+    // the finer level are asked for first, so that the misses overlap instead of each lane
+    // waiting for its own. (The coarser level has a quarter of the lines, mostly in cache; asking
+    // for them too, or on four rows' spread only, saved less in the cube.)
     if (n > 1 && std::abs(std::int64_t{plan.texel[0][0][n - 1]} - plan.texel[0][0][0]) >
-                     4 * std::max(1, texture_.width() >> plan.level[0])) {
+                     std::max(1, texture_.width() >> plan.level[0])) {
         for (int l = 0; l < n; ++l) {
             if (!plan.finite[l] || (some_lines && lines.count[l] > 1)) continue;
-            for (int step = 0; step < (plan.level_weight[l] > 0.0f ? 2 : 1); ++step) {
-                const glm::vec4* t = level(plan.level[l] + step);
-                __builtin_prefetch(t + plan.texel[step][0][l]);
-                __builtin_prefetch(t + plan.texel[step][2][l]);
-            }
+            const glm::vec4* t = level(plan.level[l]);
+            __builtin_prefetch(t + plan.texel[0][0][l]);
+            __builtin_prefetch(t + plan.texel[0][2][l]);
         }
     }
     for (int l = 0; l < n; ++l) {
