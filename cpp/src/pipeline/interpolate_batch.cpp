@@ -32,11 +32,11 @@ constexpr int kWidth = 4;
     return x < l ? l : (h < x ? h : x);
 }
 
-// Samples first … first + 3.
+// Samples first … first + 3. Untextured (no uvs, no lookups): the colour alone.
 [[gnu::always_inline]] inline void interpolate_group(const DrawInputs& draw, Shading shading, Texturing texturing,
                                                      const SetupTriangle& t, const VertexValues& colors,
-                                                     const TriangleUvs& uvs, const BatchWeights& w, int first,
-                                                     float (&channels)[4][kLookupBatch], LookupBatch& lookups) {
+                                                     const TriangleUvs* uvs, const BatchWeights& w, int first,
+                                                     float (&channels)[4][kLookupBatch], LookupBatch* lookups) {
     const Doubles l0 = load(w.l0 + first), l1 = load(w.l1 + first), l2 = load(w.l2 + first);
     const bool perspective_uv = texturing != Texturing::none && draw.uv_interpolation == Interpolation::perspective;
     // perspective_weights and interpolate_uv: q_i = λ_i / w_i and 1 / Σ q_i.
@@ -59,12 +59,13 @@ constexpr int kWidth = 4;
         }
     }
 
+    if (texturing == Texturing::none) return;
     // interpolate_uv (and texture_lookup's footprint scale).
-    const glm::dvec2 *v = uvs.v;
+    const glm::dvec2* v = uvs->v;
     Doubles u, uv_v, dudx = splat(0.0), dvdx = splat(0.0), dudy = splat(0.0), dvdy = splat(0.0);
     if (draw.uv_interpolation == Interpolation::flat) {
-        u = splat(uvs.flat.x);
-        uv_v = splat(uvs.flat.y);
+        u = splat(uvs->flat.x);
+        uv_v = splat(uvs->flat.y);
     } else if (texturing == Texturing::fixed) {  // uv only, from the normalized weights
         const bool screen = !perspective_uv;
         const Doubles w0 = screen ? l0 : q0 * inv_sum, w1 = screen ? l1 : q1 * inv_sum, w2 = screen ? l2 : q2 * inv_sum;
@@ -73,8 +74,8 @@ constexpr int kWidth = 4;
     } else if (!perspective_uv) {  // screen space: derivatives constant over the triangle
         u = l0 * v[0].x + l1 * v[1].x + l2 * v[2].x;
         uv_v = l0 * v[0].y + l1 * v[1].y + l2 * v[2].y;
-        const glm::dvec2 dx = uvs.lx.x * v[0] + uvs.lx.y * v[1] + uvs.lx.z * v[2];
-        const glm::dvec2 dy = uvs.ly.x * v[0] + uvs.ly.y * v[1] + uvs.ly.z * v[2];
+        const glm::dvec2 dx = uvs->lx.x * v[0] + uvs->lx.y * v[1] + uvs->lx.z * v[2];
+        const glm::dvec2 dy = uvs->ly.x * v[0] + uvs->ly.y * v[1] + uvs->ly.z * v[2];
         dudx = splat(dx.x), dvdx = splat(dx.y), dudy = splat(dy.x), dvdy = splat(dy.y);
     } else {  // perspective-correct, derivatives by the quotient rule
         u = (q0 * v[0].x + q1 * v[1].x + q2 * v[2].x) * inv_sum;
@@ -82,10 +83,10 @@ constexpr int kWidth = 4;
         for (int i = 0; i < 3; ++i) {
             const Doubles scale = double(t.inv_w[i]) * inv_sum;
             const Doubles rel_u = (v[i].x - u) * scale, rel_v = (v[i].y - uv_v) * scale;
-            dudx += uvs.lx[i] * rel_u;
-            dvdx += uvs.lx[i] * rel_v;
-            dudy += uvs.ly[i] * rel_u;
-            dvdy += uvs.ly[i] * rel_v;
+            dudx += uvs->lx[i] * rel_u;
+            dvdx += uvs->lx[i] * rel_v;
+            dudy += uvs->ly[i] * rel_u;
+            dvdy += uvs->ly[i] * rel_v;
         }
     }
     if (texturing == Texturing::lod && draw.footprint_scale != glm::dvec2(1.0)) {
@@ -94,22 +95,22 @@ constexpr int kWidth = 4;
         dudy *= draw.footprint_scale.y;
         dvdy *= draw.footprint_scale.y;
     }
-    store(lookups.u + first, u);
-    store(lookups.v + first, uv_v);
-    store(lookups.dudx + first, dudx);
-    store(lookups.dvdx + first, dvdx);
-    store(lookups.dudy + first, dudy);
-    store(lookups.dvdy + first, dvdy);
+    store(lookups->u + first, u);
+    store(lookups->v + first, uv_v);
+    store(lookups->dudx + first, dudx);
+    store(lookups->dvdx + first, dvdx);
+    store(lookups->dudy + first, dudy);
+    store(lookups->dvdy + first, dvdy);
 }
 
 [[gnu::always_inline]] inline void interpolate_all(const DrawInputs& draw, Shading shading, Texturing texturing,
                                                    const SetupTriangle& t, const VertexValues& colors,
-                                                   const TriangleUvs& uvs, const BatchWeights& w, glm::vec4* colour,
-                                                   LookupBatch& lookups) {
+                                                   const TriangleUvs* uvs, const BatchWeights& w, glm::vec4* colour,
+                                                   LookupBatch* lookups) {
     float channels[4][kLookupBatch];
     for (int first = 0; first < w.count; first += kWidth)
         interpolate_group(draw, shading, texturing, t, colors, uvs, w, first, channels, lookups);
-    lookups.count = w.count;
+    if (lookups) lookups->count = w.count;
     for (int i = 0; i < w.count; ++i) {
         if (shading == Shading::constant) colour[i] = draw.color;
         else if (shading == Shading::flat) colour[i] = draw.color * colors.v[0];
@@ -118,14 +119,14 @@ constexpr int kWidth = 4;
 }
 
 void interpolate_baseline(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t,
-                          const VertexValues& colors, const TriangleUvs& uvs, const BatchWeights& w, glm::vec4* colour,
-                          LookupBatch& lookups) {
+                          const VertexValues& colors, const TriangleUvs* uvs, const BatchWeights& w, glm::vec4* colour,
+                          LookupBatch* lookups) {
     interpolate_all(draw, shading, texturing, t, colors, uvs, w, colour, lookups);
 }
 #if defined(__x86_64__)
 [[gnu::target("avx2")]] void interpolate_avx2(const DrawInputs& draw, Shading shading, Texturing texturing,
-                                              const SetupTriangle& t, const VertexValues& colors, const TriangleUvs& uvs,
-                                              const BatchWeights& w, glm::vec4* colour, LookupBatch& lookups) {
+                                              const SetupTriangle& t, const VertexValues& colors, const TriangleUvs* uvs,
+                                              const BatchWeights& w, glm::vec4* colour, LookupBatch* lookups) {
     interpolate_all(draw, shading, texturing, t, colors, uvs, w, colour, lookups);
 }
 #else
@@ -141,6 +142,18 @@ bool same_nonzero_values(const VertexValues& colors) {
     return true;
 }
 
+// interpolate_batch and interpolate_colours: uvs and lookups null without texturing.
+void interpolate(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t,
+                 const VertexValues& colors, const TriangleUvs* uvs, const BatchWeights& w, glm::vec4* colour,
+                 LookupBatch* lookups) {
+    // One colour on all three vertices: the clamp to [lo, hi] makes every weighted sum that colour,
+    // so screen and perspective shading give what flat shading gives, without the sums.
+    if ((shading == Shading::screen || shading == Shading::perspective) && same_nonzero_values(colors))
+        shading = Shading::flat;
+    (BatchSampler::widest_vector() == 8 ? interpolate_avx2 : interpolate_baseline)(draw, shading, texturing, t, colors,
+                                                                                 uvs, w, colour, lookups);
+}
+
 }  // namespace
 
 bool interpolates_in_batches(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t) {
@@ -151,12 +164,12 @@ bool interpolates_in_batches(const DrawInputs& draw, Shading shading, Texturing 
 void interpolate_batch(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t,
                        const VertexValues& colors, const TriangleUvs& uvs, const BatchWeights& w, glm::vec4* colour,
                        LookupBatch& lookups) {
-    // One colour on all three vertices: the clamp to [lo, hi] makes every weighted sum that colour,
-    // so screen and perspective shading give what flat shading gives, without the sums.
-    if ((shading == Shading::screen || shading == Shading::perspective) && same_nonzero_values(colors))
-        shading = Shading::flat;
-    (BatchSampler::widest_vector() == 8 ? interpolate_avx2 : interpolate_baseline)(draw, shading, texturing, t, colors,
-                                                                                 uvs, w, colour, lookups);
+    interpolate(draw, shading, texturing, t, colors, &uvs, w, colour, &lookups);
+}
+
+void interpolate_colours(const DrawInputs& draw, Shading shading, const SetupTriangle& t, const VertexValues& colors,
+                         const BatchWeights& w, glm::vec4* colour) {
+    interpolate(draw, shading, Texturing::none, t, colors, nullptr, w, colour, nullptr);
 }
 
 }  // namespace kernels

@@ -1,6 +1,6 @@
 #pragma once
-// Interpolation for up to kLookupBatch textured samples of one triangle at once (private to the
-// pipeline): the untextured colour and the texture lookup's inputs (uv and its analytic
+// Interpolation for up to kLookupBatch samples of one triangle at once (private to the pipeline):
+// the untextured colour and, for textured samples, the texture lookup's inputs (uv and its analytic
 // derivatives), in double vectors, four samples per vector. Element by element it is the
 // arithmetic of untextured_colour and texture_lookup (sample_shading.hpp), in the same order, with
 // no fused multiply-add, so each sample gets the same bits as from those scalar functions.
@@ -33,6 +33,11 @@ bool interpolates_in_batches(const DrawInputs& draw, Shading shading, Texturing 
 void interpolate_batch(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t,
                        const VertexValues& colors, const TriangleUvs& uvs, const BatchWeights& w, glm::vec4* colour,
                        LookupBatch& lookups);
+
+/// For samples i < w.count of an untextured triangle t with screen or perspective shading, not
+/// clipped: colour[i] = untextured_colour at weights w, the same bits.
+void interpolate_colours(const DrawInputs& draw, Shading shading, const SetupTriangle& t, const VertexValues& colors,
+                         const BatchWeights& w, glm::vec4* colour);
 
 }  // namespace kernels
 }  // namespace mipraster

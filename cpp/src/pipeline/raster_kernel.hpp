@@ -12,6 +12,7 @@
 #include "mipraster/pipeline/rasterize_tile.hpp"
 #include "mipraster/pipeline/shade_texture.hpp"
 #include "mipraster/texture/sample.hpp"
+#include "interpolate_batch.hpp"
 #include "lookup_queue.hpp"
 #include "sample_row.hpp"
 #include "sample_shading.hpp"
@@ -41,6 +42,35 @@ inline void shade_into(LookupQueue<kBlend, kShading, kTexturing>* queue, float* 
     }
     const glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, screen, clip_weights, px, py);
     for (std::uint64_t m = samples; m; m &= m - 1) blend_into<kBlend>(target + 4 * __builtin_ctzll(m), c);
+}
+
+// Untextured screen or perspective shading: a sample row's passed pixels are coloured a batch at
+// a time (interpolate_colours), where one at a time their perspective weights and sums were most
+// of the kernel. (Constant and flat colours cost nothing to shade.)
+template <Shading kShading, Texturing kTexturing>
+inline constexpr bool kColoursByRow =
+    kTexturing == Texturing::none && (kShading == Shading::screen || kShading == Shading::perspective);
+
+// Shades and blends the passed pixels of a sample row of unclipped triangle t (bit j of `passed`:
+// the colour slot at target + stride·j, floats), kLookupBatch at a time: the bits shade_into
+// gives them one by one.
+template <BlendMode kBlend, Shading kShading>
+void shade_row_colours(float* target, int stride, std::uint32_t passed, const SampleRow& row, const DrawInputs& draw,
+                       const VertexValues& colors, const SetupTriangle& t) {
+    BatchWeights w;
+    glm::vec4 colour[kLookupBatch];
+    int pixel[kLookupBatch];
+    while (passed) {
+        int n = 0;
+        for (; passed && n < kLookupBatch; passed &= passed - 1, ++n) {
+            const int j = __builtin_ctz(passed);
+            pixel[n] = j;
+            w.l0[n] = row.l0[j], w.l1[n] = row.l1[j], w.l2[n] = row.l2[j];
+        }
+        w.count = n;
+        interpolate_colours(draw, kShading, t, colors, w, colour);
+        for (int i = 0; i < n; ++i) blend_into<kBlend>(target + stride * pixel[i], colour[i]);
+    }
 }
 
 // True when a draw's texture lookups go through a lookup queue (debug views never do).
@@ -136,10 +166,14 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         };
 
         // The passed pixels of a row's sample s (bit j: pixel rx0 + j) at once, as passed_sample takes
-        // them one by one: for queued lookups and the deferred pre-pass's owners (false: neither).
+        // them one by one: for queued lookups, untextured colours by row and the deferred pre-pass's
+        // owners (false: none of them).
+        constexpr bool kColours = kColoursByRow<kShading, kTexturing>;
         const auto passed_row = [&](int rx0, int py, int s, const SampleRow& row) {
             if constexpr (kShading == Shading::visibility) {
                 if (!target.owners) return false;
+            } else if constexpr (kColours) {
+                if (t.clip_index >= 0) return false;  // (original_weights: the per-sample path)
             } else if (!queue) {
                 return false;
             }
@@ -151,7 +185,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 for (std::uint32_t m = row.passed; m; m &= m - 1) owners[__builtin_ctz(m) * S] = owner;
             } else {
                 counters.shader_invocations += passed;
-                queue->push_row(color_out.at(rx0, py, s), 4 * S, row.passed, row.l0, row.l1, row.l2, rx0, py);
+                if constexpr (kColours)
+                    shade_row_colours<kBlend, kShading>(color_out.at(rx0, py, s), 4 * S, row.passed, row, draw, colors, t);
+                else
+                    queue->push_row(color_out.at(rx0, py, s), 4 * S, row.passed, row.l0, row.l1, row.l2, rx0, py);
             }
             return true;
         };
@@ -185,7 +222,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             break;
                         }
                         counters.samples_covered += static_cast<std::uint64_t>(count_bits(row.covered & ~skipped));
-                        if constexpr (kShading == Shading::visibility || kTexturing != Texturing::none)
+                        if constexpr (kShading == Shading::visibility || kTexturing != Texturing::none || kColours)
                             if (passed_row(rx0, py, s, row)) continue;
                         for (std::uint32_t m = row.passed; m; m &= m - 1) {
                             const int j = __builtin_ctz(m);
