@@ -133,28 +133,25 @@ void interpolate_baseline(const DrawInputs& draw, Shading shading, Texturing tex
 const auto interpolate_avx2 = interpolate_baseline;  // (never chosen: widest_vector() is 4)
 #endif
 
-// True when every channel has one finite, nonzero value on all three vertices. Then a weighted
-// sum (finite: the weights are) clamped to [lo, hi] = [c, c] is c with its bits; zero is left
-// out because a sum of −0 and +0 terms can give the other signed zero, which the clamp keeps.
-bool same_nonzero_values(const VertexValues& colors) {
-    for (int c = 0; c < 4; ++c)
-        if (!(colors.lo[c] == colors.hi[c] && colors.lo[c] != 0.0f && std::isfinite(colors.lo[c]))) return false;
-    return true;
-}
-
 // interpolate_batch and interpolate_colours: uvs and lookups null without texturing.
 void interpolate(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t,
                  const VertexValues& colors, const TriangleUvs* uvs, const BatchWeights& w, glm::vec4* colour,
                  LookupBatch* lookups) {
-    // One colour on all three vertices: the clamp to [lo, hi] makes every weighted sum that colour,
-    // so screen and perspective shading give what flat shading gives, without the sums.
-    if ((shading == Shading::screen || shading == Shading::perspective) && same_nonzero_values(colors))
-        shading = Shading::flat;
     (BatchSampler::widest_vector() == 8 ? interpolate_avx2 : interpolate_baseline)(draw, shading, texturing, t, colors,
                                                                                  uvs, w, colour, lookups);
 }
 
 }  // namespace
+
+Shading batch_shading(Shading shading, const VertexValues& colors) {
+    if (shading != Shading::screen && shading != Shading::perspective) return shading;
+    // One finite, nonzero value per channel on all three vertices: a weighted sum (finite: the
+    // weights are) clamped to [lo, hi] = [c, c] is c with its bits. Zero is left out because a
+    // sum of −0 and +0 terms can give the other signed zero, which the clamp keeps.
+    for (int c = 0; c < 4; ++c)
+        if (!(colors.lo[c] == colors.hi[c] && colors.lo[c] != 0.0f && std::isfinite(colors.lo[c]))) return shading;
+    return Shading::flat;
+}
 
 bool interpolates_in_batches(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t) {
     return shading != Shading::visibility && texturing != Texturing::none && t.clip_index < 0 &&

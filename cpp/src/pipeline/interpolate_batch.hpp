@@ -28,6 +28,12 @@ struct BatchWeights {
 /// perspective-correct with analytic derivatives (or none); the triangle not clipped.
 bool interpolates_in_batches(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t);
 
+/// The shading the batches of a triangle with vertex colours `colors` take, for `shading`: flat
+/// where screen or perspective shading has one colour on all three vertices (the clamp to the
+/// vertices' range makes every weighted sum that colour: the same bits, without the sums).
+/// Once per triangle, not per batch.
+Shading batch_shading(Shading shading, const VertexValues& colors);
+
 /// For samples i < w.count of triangle t: colour[i] = untextured_colour at weights w, and lane i of
 /// `lookups` = texture_lookup's uv and derivatives as floats (lookups.count = w.count).
 void interpolate_batch(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t,

@@ -33,7 +33,8 @@ public:
         if (current_queued_) ++current_;  // keep the triangle of the samples already queued
         current_queued_ = false;
         triangles_[current_] = {&t, clip_weights, colors, uvs,
-                                interpolates_in_batches(draw_, kShading, kTexturing, t)};
+                                interpolates_in_batches(draw_, kShading, kTexturing, t),
+                                batch_shading(kShading, colors)};
     }
 
     /// Queues the shade of samples `samples` (a bit mask) at 4-float colour slots of `target`:
@@ -67,7 +68,7 @@ public:
         const Triangle& first = triangles_[pending_[0].triangle];
         if (first.batched && pending_[count_ - 1].triangle == pending_[0].triangle) {  // (triangles only advance)
             weights_.count = count_;
-            interpolate_batch(draw_, kShading, kTexturing, *first.t, first.colors, first.uvs, weights_, colour,
+            interpolate_batch(draw_, first.shading, kTexturing, *first.t, first.colors, first.uvs, weights_, colour,
                               lookups_);
         } else {
             for (int i = 0; i < count_; ++i) {
@@ -111,7 +112,8 @@ private:
         const ClipWeights* clip_weights;
         VertexValues colors;
         TriangleUvs uvs;
-        bool batched;  // interpolates_in_batches
+        bool batched;     // interpolates_in_batches
+        Shading shading;  // batch_shading
     };
     struct Pending {
         float* target;

@@ -54,9 +54,10 @@ inline constexpr bool kColoursByRow =
 // Shades and blends the passed pixels of a sample row of unclipped triangle t (bit j of `passed`:
 // the colour slot at target + stride·j, floats), kLookupBatch at a time: the bits shade_into
 // gives them one by one.
-template <BlendMode kBlend, Shading kShading>
+// `shading`: batch_shading of the triangle's colours.
+template <BlendMode kBlend>
 void shade_row_colours(float* target, int stride, std::uint32_t passed, const SampleRow& row, const DrawInputs& draw,
-                       const VertexValues& colors, const SetupTriangle& t) {
+                       Shading shading, const VertexValues& colors, const SetupTriangle& t) {
     BatchWeights w;
     glm::vec4 colour[kLookupBatch];
     int pixel[kLookupBatch];
@@ -68,7 +69,7 @@ void shade_row_colours(float* target, int stride, std::uint32_t passed, const Sa
             w.l0[n] = row.l0[j], w.l1[n] = row.l1[j], w.l2[n] = row.l2[j];
         }
         w.count = n;
-        interpolate_colours(draw, kShading, t, colors, w, colour);
+        interpolate_colours(draw, shading, t, colors, w, colour);
         for (int i = 0; i < n; ++i) blend_into<kBlend>(target + stride * pixel[i], colour[i]);
     }
 }
@@ -169,6 +170,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         // them one by one: for queued lookups, untextured colours by row and the deferred pre-pass's
         // owners (false: none of them).
         constexpr bool kColours = kColoursByRow<kShading, kTexturing>;
+        std::optional<Shading> row_shading;  // batch_shading, when a row first needs it
         const auto passed_row = [&](int rx0, int py, int s, const SampleRow& row) {
             if constexpr (kShading == Shading::visibility) {
                 if (!target.owners) return false;
@@ -185,10 +187,13 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 for (std::uint32_t m = row.passed; m; m &= m - 1) owners[__builtin_ctz(m) * S] = owner;
             } else {
                 counters.shader_invocations += passed;
-                if constexpr (kColours)
-                    shade_row_colours<kBlend, kShading>(color_out.at(rx0, py, s), 4 * S, row.passed, row, draw, colors, t);
-                else
+                if constexpr (kColours) {
+                    if (!row_shading) row_shading = batch_shading(kShading, colors);
+                    shade_row_colours<kBlend>(color_out.at(rx0, py, s), 4 * S, row.passed, row, draw, *row_shading,
+                                              colors, t);
+                } else {
                     queue->push_row(color_out.at(rx0, py, s), 4 * S, row.passed, row.l0, row.l1, row.l2, rx0, py);
+                }
             }
             return true;
         };
