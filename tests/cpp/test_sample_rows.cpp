@@ -78,6 +78,37 @@ TEST(SampleRows, SameBitsAndCountersAsThePerSamplePathOnOverlappingScenes) {
     }
 }
 
+TEST(SampleRows, UntexturedRowsColouredInBatchesGiveThePerSampleBits) {
+    // Untextured screen and perspective shading colours a row's passed pixels in batches
+    // (interpolate_colours), skipping the weighted sums of one-colour triangles: the per-sample
+    // bits for vertex colours, one colour per triangle, and one colour with a +0 or −0 channel
+    // (where the sums must run: they can give the other signed zero).
+    const int W = 96, H = 80;
+    const mr::Mesh coloured = overlapping(150, 2.5, 43);
+    mr::Mesh tinted = coloured;
+    for (std::size_t v = 0; v < tinted.colors.size(); ++v) {
+        tinted.colors[v] = tinted.colors[v - v % 3];
+        if (v / 3 % 4 == 1) tinted.colors[v].g = 0.0f;
+        if (v / 3 % 4 == 2) tinted.colors[v].b = -0.0f;
+    }
+    const mr::Camera cam = overlap_camera(mr::DepthConvention::reverse_z, W, H);
+    for (const mr::Mesh* mesh : std::initializer_list<const mr::Mesh*>{&coloured, &tinted})
+        for (mr::BlendMode blend : {mr::BlendMode::replace, mr::BlendMode::over})
+            for (mr::Interpolation interpolation : {mr::Interpolation::perspective, mr::Interpolation::screen})
+                for (int samples : {1, 4}) {
+                    SCOPED_TRACE(std::string(mesh == &tinted ? "tinted, " : "") + mr::to_string(blend) + ", " +
+                                 mr::to_string(interpolation) + ", " + std::to_string(samples) + " samples");
+                    mr::DrawState state;
+                    state.blend = blend;
+                    state.interpolation = interpolation;
+                    const std::vector<mr::Draw> draws = {make_draw(*mesh, glm::dmat4(1.0), state, glm::vec4(0.9f, 0.7f, 1.0f, 0.8f))};
+                    auto s = settings(W, H, samples);
+                    s.anti_aliasing = mr::AntiAliasing::ssaa;
+                    s.clear_color = glm::vec4(0.1f, -0.0f, 0.3f, 1.0f);
+                    expect_same_with_and_without_rows(draws, cam, s);
+                }
+}
+
 TEST(SampleRows, SamplesOnEdgesFollowTheTopLeftRule) {
     // A grid of 8×8-pixel squares, each cut along a diagonal, with every vertex on a pixel centre:
     // the edges run through sample positions, so which triangle gets them is the top-left rule's
