@@ -117,6 +117,40 @@ TEST(ShadeTexture, AnalyticDerivativesMatchCentralDifferencesOfThePerspectiveCor
     RecordProperty("worst_relative_derivative_error", std::to_string(worst));
 }
 
+TEST(ShadeTexture, DerivativesDoNotChangeWhenEveryUvIsShiftedFarFromZero) {
+    // uv + c changes by what uv changes by: the derivatives of a triangle with its uvs moved by
+    // 2^16 (exact in float: the uvs are multiples of 1/64) are those of the unmoved one to 1e-9
+    // relative (seen: 3e-12), although the sums that form them hold terms 2^16 times larger.
+    std::mt19937_64 rng(11);
+    std::uniform_int_distribution<int> sixty_fourths(-192, 192);
+    double worst = 0.0;
+    int checked = 0;
+    for (int n = 0; n < 300 && checked < 3000; ++n) {
+        Case c;
+        if (!random_case(rng, c)) continue;
+        Case moved = c;
+        for (int i = 0; i < 3; ++i) {
+            c.uv[i] = {sixty_fourths(rng) / 64.0, sixty_fourths(rng) / 64.0};
+            moved.uv[i] = c.uv[i] + 65536.0;
+        }
+        const mr::TriangleUvs uvs = triangle_uvs(c), moved_uvs = triangle_uvs(moved);
+        for (int py = c.setup.min_y; py <= c.setup.max_y; py += 3)
+            for (int px = c.setup.min_x; px <= c.setup.max_x; px += 3) {
+                const glm::dvec3 l = weights_at(c.setup, px * std::int64_t{256} + 128, py * std::int64_t{256} + 128);
+                if (l.x < 0 || l.y < 0 || l.z < 0) continue;
+                const mr::UvSample s = mr::interpolate_uv(c.setup, uvs, l, mr::Interpolation::perspective);
+                const mr::UvSample m = mr::interpolate_uv(c.setup, moved_uvs, l, mr::Interpolation::perspective);
+                const double scale = 1.0 + glm::length(s.dx) + glm::length(s.dy);
+                for (int k = 0; k < 2; ++k)
+                    worst = std::max({worst, std::abs(m.dx[k] - s.dx[k]) / scale, std::abs(m.dy[k] - s.dy[k]) / scale});
+                ++checked;
+            }
+    }
+    EXPECT_GT(checked, 1000);
+    EXPECT_LT(worst, 1e-9) << "worst relative derivative change " << worst;
+    RecordProperty("worst_relative_derivative_change", std::to_string(worst));
+}
+
 TEST(ShadeTexture, FlatInterpolationUsesTheProvokingVertexUvWithZeroDerivatives) {
     std::mt19937_64 rng(3);
     Case c;

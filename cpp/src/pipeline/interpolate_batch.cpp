@@ -80,14 +80,10 @@ constexpr int kWidth = 4;
     } else {  // perspective-correct, derivatives by the quotient rule
         u = (q0 * v[0].x + q1 * v[1].x + q2 * v[2].x) * inv_sum;
         uv_v = (q0 * v[0].y + q1 * v[1].y + q2 * v[2].y) * inv_sum;
-        for (int i = 0; i < 3; ++i) {
-            const Doubles scale = double(t.inv_w[i]) * inv_sum;
-            const Doubles rel_u = (v[i].x - u) * scale, rel_v = (v[i].y - uv_v) * scale;
-            dudx += uvs->lx[i] * rel_u;
-            dvdx += uvs->lx[i] * rel_v;
-            dudy += uvs->ly[i] * rel_u;
-            dvdy += uvs->ly[i] * rel_v;
-        }
+        dudx = (splat(uvs->numerator_dx.x) - u * uvs->denominator_dx) * inv_sum;
+        dvdx = (splat(uvs->numerator_dx.y) - uv_v * uvs->denominator_dx) * inv_sum;
+        dudy = (splat(uvs->numerator_dy.x) - u * uvs->denominator_dy) * inv_sum;
+        dvdy = (splat(uvs->numerator_dy.y) - uv_v * uvs->denominator_dy) * inv_sum;
     }
     if (texturing == Texturing::lod && draw.footprint_scale != glm::dvec2(1.0)) {
         dudx *= draw.footprint_scale.x;

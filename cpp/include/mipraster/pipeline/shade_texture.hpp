@@ -46,6 +46,10 @@ struct TriangleUvs {
     glm::dvec2 v[3];
     glm::dvec2 flat;
     glm::dvec3 lx, ly;  // ∂λ_i/∂x = a_i·256/2A, ∂λ_i/∂y = b_i·256/2A
+    // Perspective-correct uv = N/D with N = Σ λ_i q_i uv_i and D = Σ λ_i q_i (q_i = 1/w_i): their
+    // changes per pixel step are constant over the triangle.
+    glm::dvec2 numerator_dx, numerator_dy;  // Σ ∂λ_i/∂x·q_i·uv_i, and along y
+    double denominator_dx, denominator_dy;  // Σ ∂λ_i/∂x·q_i, and along y
 
     TriangleUvs() = default;
     TriangleUvs(const SetupTriangle& t, const glm::uvec3& tri, const glm::vec2* uvs, const ClipWeights* clip_weights) {
@@ -62,12 +66,19 @@ struct TriangleUvs {
                 v[i] = w.x * o[0] + w.y * o[1] + w.z * o[2];
             }
         }
+        const glm::dvec3 q(t.inv_w[0], t.inv_w[1], t.inv_w[2]);
+        const glm::dvec3 qx = lx * q, qy = ly * q;
+        numerator_dx = qx.x * v[0] + qx.y * v[1] + qx.z * v[2];
+        numerator_dy = qy.x * v[0] + qy.y * v[1] + qy.z * v[2];
+        denominator_dx = qx.x + qx.y + qx.z;
+        denominator_dy = qy.x + qy.y + qy.z;
     }
 };
 
 /// uv at screen-space weights l with analytic derivatives. Screen weights are affine in the
-/// pixel position: ∂λ_i/∂x = a_i·256/2A. Perspective-correct uv = Σλ_i q_i uv_i / Σλ_i q_i with
-/// q_i = 1/w_i, so ∂uv/∂x = Σ ∂λ_i/∂x · q_i · (uv_i − uv) / Σλ_i q_i (the quotient rule).
+/// pixel position: ∂λ_i/∂x = a_i·256/2A. Perspective-correct uv = N/D = Σλ_i q_i uv_i / Σλ_i q_i
+/// with q_i = 1/w_i, so ∂uv/∂x = (∂N/∂x − uv·∂D/∂x) / D (the quotient rule), with ∂N/∂x and ∂D/∂x
+/// the triangle's constants.
 /// Without kDerivatives only uv is computed (dx, dy stay zero).
 template <bool kDerivatives = true>
 inline UvSample interpolate_uv(const SetupTriangle& t, const TriangleUvs& uvs, const glm::dvec3& l,
@@ -93,11 +104,8 @@ inline UvSample interpolate_uv(const SetupTriangle& t, const TriangleUvs& uvs, c
     const glm::dvec3 q(l.x * t.inv_w[0], l.y * t.inv_w[1], l.z * t.inv_w[2]);
     const double inv_d = 1.0 / (q.x + q.y + q.z);
     s.uv = (q.x * uvs.v[0] + q.y * uvs.v[1] + q.z * uvs.v[2]) * inv_d;
-    for (int i = 0; i < 3; ++i) {
-        const glm::dvec2 rel = (uvs.v[i] - s.uv) * (static_cast<double>(t.inv_w[i]) * inv_d);
-        s.dx += lx[i] * rel;
-        s.dy += ly[i] * rel;
-    }
+    s.dx = (uvs.numerator_dx - s.uv * uvs.denominator_dx) * inv_d;
+    s.dy = (uvs.numerator_dy - s.uv * uvs.denominator_dy) * inv_d;
     return s;
 }
 
