@@ -383,8 +383,23 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
             return lerp_quad(load(t[q[0][l]]), load(t[q[1][l]]), load(t[q[2][l]]), load(t[q[3][l]]), plan.fx[step][l],
                              plan.fy[step][l]);
         };
-        Texel c = quad(0);
-        if (plan.level_weight[l] > 0.0f) c = lerp(c, quad(1), plan.level_weight[l]);
+        Texel c;
+        if (plan.level_weight[l] > 0.0f) {
+#if defined(__AVX__)  // both levels' quads side by side: the same operations per half
+            const glm::vec4 *finer = level(plan.level[l]), *coarser = level(plan.level[l] + 1);
+            const auto corner = [&](int k) {
+                return load_pair(finer[plan.texel[0][k][l]], coarser[plan.texel[1][k][l]]);
+            };
+            const TexelPair top = lerp_pair(corner(0), corner(1), plan.fx[0][l], plan.fx[1][l]);
+            const TexelPair bottom = lerp_pair(corner(2), corner(3), plan.fx[0][l], plan.fx[1][l]);
+            const TexelPair both = lerp_pair(top, bottom, plan.fy[0][l], plan.fy[1][l]);
+            c = lerp(finer_half(both), coarser_half(both), plan.level_weight[l]);
+#else
+            c = lerp(quad(0), quad(1), plan.level_weight[l]);
+#endif
+        } else {
+            c = quad(0);
+        }
         out[l] = to_vec4(c);
     }
 }
