@@ -1,7 +1,7 @@
 // Sample rows (RenderSettings::sample_rows): at one sample per pixel or SSAA, a depth-tested
 // triangle's coverage, screen weights and depth tests along a row run four pixels per vector
-// (sample by sample under SSAA). Colour, depth and every counter are bit for bit those of the
-// per-sample path — for both depth conventions, every blend and interpolation, textured or not,
+// (sample by sample under SSAA); under MSAA a pixel's depth tests run four samples per vector.
+// Colour, depth and every counter are bit for bit those of the per-sample path — for both depth conventions, every blend and interpolation, textured or not,
 // depth written or only read, with and without block skipping and deferred shading — including
 // triangles whose edge values along a row pass 2^52, where the rows fall back to the per-sample
 // path.
@@ -12,6 +12,7 @@
 #include <cstring>
 #include <random>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -59,16 +60,21 @@ TEST(SampleRows, SameBitsAndCountersAsThePerSamplePathOnOverlappingScenes) {
                     draws[0].texture = texture;
                     draws[3].state.interpolation = mr::Interpolation::flat;
                     draws[4].mesh = &b;
-                    // One sample per pixel, and SSAA (rows sample by sample), with sample counts
-                    // that fill vectors of four and counts that do not.
-                    for (const auto& [samples, pattern] : {std::pair{1, mr::PatternKind::automatic},
-                                                           std::pair{4, mr::PatternKind::rotated},
-                                                           std::pair{6, mr::PatternKind::stratified}}) {
+                    // One sample per pixel, SSAA (rows sample by sample) and MSAA (a pixel's
+                    // samples four per vector), with sample counts that fill vectors of four and
+                    // counts that do not.
+                    for (const auto& [samples, pattern, aa] :
+                         {std::tuple{1, mr::PatternKind::automatic, mr::AntiAliasing::ssaa},
+                          std::tuple{4, mr::PatternKind::rotated, mr::AntiAliasing::ssaa},
+                          std::tuple{6, mr::PatternKind::stratified, mr::AntiAliasing::ssaa},
+                          std::tuple{4, mr::PatternKind::rotated, mr::AntiAliasing::msaa},
+                          std::tuple{8, mr::PatternKind::stratified, mr::AntiAliasing::msaa},
+                          std::tuple{6, mr::PatternKind::stratified, mr::AntiAliasing::msaa}}) {
                         SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(blend) + ", " +
                                      mr::to_string(interpolation) + (skipping ? ", block skipping" : "") + ", " +
-                                     std::to_string(samples) + " samples");
+                                     std::to_string(samples) + " samples " + mr::to_string(aa));
                         auto s = settings(W, H, samples, pattern);
-                        s.anti_aliasing = mr::AntiAliasing::ssaa;
+                        s.anti_aliasing = aa;
                         s.threads = 1;
                         s.block_skipping = skipping;
                         s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);

@@ -60,8 +60,10 @@ struct RenderSettings {
     /// sample counters are the same either way; false runs the plain per-sample path, for comparison.
     bool block_skipping = true;
     /// At one sample per pixel and under SSAA, a depth-tested triangle's coverage, weights and
-    /// depth tests along a row of pixels run four pixels per vector (sample by sample); the output
-    /// and counters are the same bits either way; false runs the per-sample path, for comparison.
+    /// depth tests along a row of pixels run four pixels per vector (sample by sample); under MSAA
+    /// (a multiple of four samples, AVX2) a pixel's depth tests run four samples per vector. The
+    /// output and counters are the same bits either way; false runs the per-sample path, for
+    /// comparison.
     bool sample_rows = true;
     /// Where a tile's triangles overlap kDeferredMinOverdraw deep or more and every draw blends by
     /// replacing (at 1 sample or SSAA), shade only the samples that stay visible: a pre-pass
