@@ -52,13 +52,13 @@ template <Shading kShading, Texturing kTexturing>
 inline constexpr bool kColoursByRow =
     kTexturing == Texturing::none && (kShading == Shading::screen || kShading == Shading::perspective);
 
-// Shades and blends the passed pixels of a sample row of unclipped triangle t (bit j of `passed`:
-// the colour slot at target + stride·j, floats), kLookupBatch at a time: the bits shade_into
-// gives them one by one.
-// `shading`: batch_shading of the triangle's colours.
+// Shades and blends pixels `passed` of a row of unclipped triangle t (bit j: screen weights l0[j],
+// l1[j], l2[j], the colour slot at target + stride·j, floats), kLookupBatch at a time: the bits
+// shade_into gives them one by one. `shading`: batch_shading of the triangle's colours.
 template <BlendMode kBlend>
-void shade_row_colours(float* target, int stride, std::uint32_t passed, const SampleRow& row, const DrawInputs& draw,
-                       Shading shading, const VertexValues& colors, const SetupTriangle& t) {
+void shade_row_colours(float* target, int stride, std::uint32_t passed, const double* l0, const double* l1,
+                       const double* l2, const DrawInputs& draw, Shading shading, const VertexValues& colors,
+                       const SetupTriangle& t) {
     BatchWeights w;
     glm::vec4 colour[kLookupBatch];
     int pixel[kLookupBatch];
@@ -67,7 +67,7 @@ void shade_row_colours(float* target, int stride, std::uint32_t passed, const Sa
         for (; passed && n < kLookupBatch; passed &= passed - 1, ++n) {
             const int j = __builtin_ctz(passed);
             pixel[n] = j;
-            w.l0[n] = row.l0[j], w.l1[n] = row.l1[j], w.l2[n] = row.l2[j];
+            w.l0[n] = l0[j], w.l1[n] = l1[j], w.l2[n] = l2[j];
         }
         w.count = n;
         interpolate_colours(draw, shading, t, colors, w, colour);
@@ -200,8 +200,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 counters.shader_invocations += passed;
                 if constexpr (kColours) {
                     if (!row_shading) row_shading = batch_shading(kShading, colors);
-                    shade_row_colours<kBlend>(color_out.at(rx0, py, s), 4 * S, row.passed, row, draw, *row_shading,
-                                              colors, t);
+                    shade_row_colours<kBlend>(color_out.at(rx0, py, s), 4 * S, row.passed, row.l0, row.l1, row.l2, draw,
+                                              *row_shading, colors, t);
                 } else {
                     queue->push_row(color_out.at(rx0, py, s), 4 * S, row.passed, row.l0, row.l1, row.l2, rx0, py);
                 }
@@ -373,6 +373,7 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
     OwnerRef ref{};
     VertexValues colors{};
     TriangleUvs uvs{};
+    Shading run_shading = kShading;  // batch_shading of colors, for untextured runs (kColoursByRow)
     std::optional<LookupQueue<BlendMode::replace, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
     // Makes `owner` the current triangle if it is one of this draw's (false: another draw's).
@@ -385,6 +386,7 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
         const glm::uvec3 tri = draw.triangles[ref.triangle->triangle];
         if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective)
             colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
+        if constexpr (kColoursByRow<kShading, kTexturing>) run_shading = batch_shading(kShading, colors);
         if constexpr (kTexturing != Texturing::none) {
             uvs = TriangleUvs(*ref.triangle, tri, draw.uvs, ref.clip_weights);
             if (queue) queue->begin_triangle(*ref.triangle, colors, uvs, ref.clip_weights);
@@ -422,10 +424,14 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
                 edges_at(px, py, 0, e);
                 if (end - px >= kSampleRowMinPixels && sample_row_weights(*ref.triangle, e, end - px, l0, l1, l2)) {
                     const int n = end - px;
+                    const std::uint32_t run = ~std::uint32_t{0} >> (32 - n);
                     if (queue) {  // the run as one mask
                         counters.shader_invocations += static_cast<std::uint64_t>(n);
-                        queue->push_row(target.color.at(px, py, 0), 4, ~std::uint32_t{0} >> (32 - n), l0, l1, l2, px,
-                                        py);
+                        queue->push_row(target.color.at(px, py, 0), 4, run, l0, l1, l2, px, py);
+                    } else if (kColoursByRow<kShading, kTexturing> && ref.triangle->clip_index < 0) {
+                        counters.shader_invocations += static_cast<std::uint64_t>(n);
+                        shade_row_colours<BlendMode::replace>(target.color.at(px, py, 0), 4, run, l0, l1, l2, draw,
+                                                              run_shading, colors, *ref.triangle);
                     } else {
                         for (int j = 0; j < n; ++j) shade_sample(px + j, py, 0, glm::dvec3(l0[j], l1[j], l2[j]));
                     }
