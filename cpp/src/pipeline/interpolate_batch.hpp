@@ -35,13 +35,14 @@ bool interpolates_in_batches(const DrawInputs& draw, Shading shading, Texturing 
 Shading batch_shading(Shading shading, const VertexValues& colors);
 
 /// For samples i < w.count of triangle t: colour[i] = untextured_colour at weights w, and lane i of
-/// `lookups` = texture_lookup's uv and derivatives as floats (lookups.count = w.count).
+/// `lookups` = texture_lookup's uv and derivatives as floats (lookups.count = w.count). `shading`:
+/// the draw's, or batch_shading of it (faster, the same bits).
 void interpolate_batch(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t,
                        const VertexValues& colors, const TriangleUvs& uvs, const BatchWeights& w, glm::vec4* colour,
                        LookupBatch& lookups);
 
-/// For samples i < w.count of an untextured triangle t with screen or perspective shading, not
-/// clipped: colour[i] = untextured_colour at weights w, the same bits.
+/// For samples i < w.count of an untextured triangle t, not clipped: colour[i] = untextured_colour
+/// at weights w, the same bits (`shading` as for interpolate_batch).
 void interpolate_colours(const DrawInputs& draw, Shading shading, const SetupTriangle& t, const VertexValues& colors,
                          const BatchWeights& w, glm::vec4* colour);
 

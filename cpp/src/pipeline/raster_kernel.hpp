@@ -46,8 +46,8 @@ inline void shade_into(LookupQueue<kBlend, kShading, kTexturing>* queue, float* 
 }
 
 // Untextured screen or perspective shading: a sample row's passed pixels are coloured a batch at
-// a time (interpolate_colours), where one at a time their perspective weights and sums were most
-// of the kernel. (Constant and flat colours cost nothing to shade.)
+// a time (interpolate_colours); one at a time, their perspective weights and sums were half of
+// the kernel. (Constant and flat colours cost nothing to shade.)
 template <Shading kShading, Texturing kTexturing>
 inline constexpr bool kColoursByRow =
     kTexturing == Texturing::none && (kShading == Shading::screen || kShading == Shading::perspective);

@@ -5,6 +5,9 @@
 #include <cstring>
 
 #include <glm/vec4.hpp>
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 namespace mipraster {
 namespace texel {
@@ -30,7 +33,6 @@ inline Texel lerp_quad(Texel a, Texel b, Texel c, Texel d, float ax, float ay) {
 }
 
 #if defined(__AVX__)
-#include <immintrin.h>
 // A texel of each of two mip levels in one AVX register (builds for x86-64-v3): the bilinear
 // blends of both levels' quads at once, each half the arithmetic of lerp_quad on its own.
 #pragma GCC diagnostic push
