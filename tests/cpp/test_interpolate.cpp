@@ -315,6 +315,13 @@ TEST(Interpolate, VertexValuesInterpolateIsTheClampedWeightedSum) {
             const float want = std::clamp(sum, values.lo[k], values.hi[k]);
             clamped_low += sum < values.lo[k];
             clamped_high += values.hi[k] < sum;
+            // A NaN's sign and payload depend on which operand of a sum the compiler puts first
+            // (IEEE leaves them open; the sanitizer build ordered this sum differently): a NaN only
+            // has to stay a NaN.
+            if (std::isnan(want)) {
+                ASSERT_TRUE(std::isnan(got[k])) << "trial " << trial << " component " << k;
+                continue;
+            }
             ASSERT_EQ(bits(got[k]), bits(want)) << "trial " << trial << " component " << k;
         }
     }
