@@ -15,11 +15,6 @@ bool below_2_to_51(std::int64_t x) {
 
 }  // namespace
 
-bool has_pixel_samples_avx2() {
-    static const bool avx2 = __builtin_cpu_supports("avx2");
-    return avx2;
-}
-
 [[gnu::target("avx2")]] bool test_pixel_samples_avx2(const SetupTriangle& t, const PixelSamples& p,
                                                      std::uint64_t covered, DepthFunc func, bool depth_write,
                                                      float* depth, std::uint64_t& passed) {

@@ -23,12 +23,10 @@ struct PixelSamples {
 /// Tests the depth of samples `covered` (bit s: sample s) against depth[s] (less or greater) and
 /// stores the passing depths when depth_write; the passing samples go to `passed`. Returns
 /// false, touching nothing, when an edge value reaches 2^51 in magnitude (its sums in double
-/// could round): the per-sample path then runs. Needs AVX2 (has_pixel_samples_avx2()).
+/// could round): the per-sample path then runs. Needs AVX2 (BatchSampler::widest_vector() == 8;
+/// elsewhere the kernel keeps the per-sample path).
 bool test_pixel_samples_avx2(const SetupTriangle& t, const PixelSamples& p, std::uint64_t covered, DepthFunc func,
                              bool depth_write, float* depth, std::uint64_t& passed);
-
-/// True where the CPU has AVX2 (else the kernel keeps the per-sample path).
-bool has_pixel_samples_avx2();
 
 }  // namespace kernels
 }  // namespace mipraster

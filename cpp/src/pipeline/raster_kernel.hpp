@@ -151,7 +151,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         const std::uint64_t all_samples = S == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << S) - 1;
         double offset1[kMaxSamples], offset2[kMaxSamples];
         const bool pixel_vectors = kMode == SampleMode::msaa && kDepth != DepthFunc::none && target.sample_rows &&
-                                   S % 4 == 0 && has_pixel_samples_avx2();
+                                   S % 4 == 0 && BatchSampler::widest_vector() == 8;
         if (pixel_vectors)
             for (int s = 0; s < S; ++s) offset1[s] = static_cast<double>(off1[s]), offset2[s] = static_cast<double>(off2[s]);
 
