@@ -52,17 +52,21 @@ Framebuffer make_framebuffer(int width, int height, int samples, glm::vec4 clear
 }
 
 void SampleWindow::fill(int x0, int y0, int x1, int y1, const glm::vec4& value) const {
-    // A row of the rectangle is contiguous. Depth (1 channel) and colour (4) get loops the compiler
-    // turns into vector stores: the per-channel loop stored one float at a time (6 % of a 1080p
-    // textured frame went to clears).
+    // A row of the rectangle is contiguous. Depth (1 channel) and colour (4) get loops of vector
+    // stores: the per-channel loop stored one float at a time, and a 16-byte copy per sample
+    // became two 8-byte stores (5 % of a 1080p textured frame went to clears).
     const float v[4] = {value[0], value[1], value[2], value[3]};
     const std::size_t n = static_cast<std::size_t>(x1 - x0) * static_cast<std::size_t>(samples);  // per row
+    typedef float TwoSamples __attribute__((vector_size(32), aligned(4)));
+    const TwoSamples two{v[0], v[1], v[2], v[3], v[0], v[1], v[2], v[3]};
     for (int y = y0; y < y1; ++y) {
         float* const p = at(x0, y, 0);
         if (channels == 1) {
             std::fill(p, p + n, v[0]);
         } else if (channels == 4) {
-            for (std::size_t i = 0; i < n; ++i) std::memcpy(p + 4 * i, v, sizeof v);
+            std::size_t i = 0;
+            for (; i + 2 <= n; i += 2) std::memcpy(p + 4 * i, &two, sizeof two);
+            if (i < n) std::memcpy(p + 4 * i, v, sizeof v);
         } else {
             for (std::size_t i = 0; i < n; ++i)
                 for (int c = 0; c < channels; ++c) p[i * static_cast<std::size_t>(channels) + c] = v[c];
