@@ -156,11 +156,19 @@ template <int W>
     }
 }
 
-// Lanes first … first + W − 1 of the plan: whether they are finite, their level(s) and the
-// bilinear quads on them.
+// What the quads of lanes first … first + W − 1 start from: their wrapped positions and finer level.
 template <int W>
-[[gnu::always_inline]] inline void plan_lanes(const LookupBatch& b, const float* rho2_scale, int first, const Sampler& s,
-                                              int width_texels, int height_texels, int levels, LanePlan& plan) {
+struct LaneLevels {
+    typename Lanes<W>::Floats u, v;
+    typename Lanes<W>::Ints fine;
+    bool blends;  // some lane blends two levels
+};
+
+// Lanes first … first + W − 1 of the plan, part one: whether they are finite and their level(s).
+template <int W>
+[[gnu::always_inline]] inline LaneLevels<W> plan_levels(const LookupBatch& b, const float* rho2_scale, int first,
+                                                        const Sampler& s, int width_texels, int height_texels,
+                                                        int levels, LanePlan& plan) {
     MIPRASTER_LANES(W);
     Floats u = load_v<Floats>(first + b.u), v = load_v<Floats>(first + b.v);
     const Floats width = splat<Floats>(static_cast<float>(width_texels)), height = splat<Floats>(static_cast<float>(height_texels));
@@ -198,11 +206,20 @@ template <int W>
     weight = fine + 1 < levels ? weight : splat<Floats>(0.0f);
     std::memcpy(plan.level + first, &fine, sizeof fine);
     std::memcpy(plan.level_weight + first, &weight, sizeof weight);
+    std::memcpy(plan.finite + first, &finite, sizeof finite);
+    return {u, v, fine, s.needs_derivatives() && s.mip_filter == MipFilter::linear && any(weight > 0.0f)};
+}
 
-    // Both levels' quads: level k and k + 1 (sizes max(1, ⌊w/2^k⌋), exact in float); only level
-    // k where no lane blends (λ an integer: an exact 2^k footprint, or magnification).
-    const int steps = s.needs_derivatives() && s.mip_filter == MipFilter::linear && any(weight > 0.0f) ? 2 : 1;
-    for (int step = 0; step < steps; ++step) {
+// Part two: the bilinear quads on level k and k + 1 (sizes max(1, ⌊w/2^k⌋), exact in float); only
+// on level k where no lane blends (λ an integer: an exact 2^k footprint, or magnification).
+template <int W>
+[[gnu::always_inline]] inline void plan_quads(const LaneLevels<W>& lanes, int first, const Sampler& s, int width_texels,
+                                              int height_texels, int levels, LanePlan& plan) {
+    MIPRASTER_LANES(W);
+    const Floats width = splat<Floats>(static_cast<float>(width_texels)), height = splat<Floats>(static_cast<float>(height_texels));
+    const Ints fine = lanes.fine;
+    const Floats u = lanes.u, v = lanes.v;
+    for (int step = 0; step < (lanes.blends ? 2 : 1); ++step) {
         const Ints k = min_v(fine + step, Ints{} + (levels - 1));
         const Ints scale_bits = (127 - k) << 23;
         const Floats scale = bits_as<Floats>(scale_bits);  // 2^−k
@@ -223,20 +240,25 @@ template <int W>
         store_v(plan.fx[step] + first, fx);
         store_v(plan.fy[step] + first, fy);
     }
-    std::memcpy(plan.finite + first, &finite, sizeof finite);
 }
 
 // The plan of lanes 0 … count − 1: four at a time on the baseline, eight with AVX2. Sixteen lanes
-// are two (or four) independent chains of arithmetic back to back, which the CPU overlaps: a
-// batch of eight left the planner waiting on one chain's latency.
+// are two (or four) independent chains of arithmetic, which the CPU overlaps: a batch of eight
+// left the planner waiting on one chain's latency. With AVX2 both halves' levels come first, so
+// that their λ chains (a division and a polynomial) are near enough in the code to overlap.
 void plan_sse2(const LookupBatch& b, const float* rho2_scale, int count, const Sampler& s, int width, int height,
                int levels, LanePlan& plan) {
-    for (int first = 0; first < count; first += 4) plan_lanes<4>(b, rho2_scale, first, s, width, height, levels, plan);
+    for (int first = 0; first < count; first += 4)
+        plan_quads<4>(plan_levels<4>(b, rho2_scale, first, s, width, height, levels, plan), first, s, width, height,
+                      levels, plan);
 }
 #if defined(__x86_64__)
 [[gnu::target("avx2")]] void plan_avx2(const LookupBatch& b, const float* rho2_scale, int, const Sampler& s, int width,
                                       int height, int levels, LanePlan& plan) {
-    for (int first = 0; first < kLookupBatch; first += 8) plan_lanes<8>(b, rho2_scale, first, s, width, height, levels, plan);
+    const LaneLevels<8> low = plan_levels<8>(b, rho2_scale, 0, s, width, height, levels, plan);
+    const LaneLevels<8> high = plan_levels<8>(b, rho2_scale, 8, s, width, height, levels, plan);
+    plan_quads<8>(low, 0, s, width, height, levels, plan);
+    plan_quads<8>(high, 8, s, width, height, levels, plan);
 }
 #else  // (other CPUs: the four-lane path; never called)
 void plan_avx2(const LookupBatch& b, const float* rho2_scale, int count, const Sampler& s, int width, int height,
