@@ -78,6 +78,13 @@ template <typename To, typename From>
 }
 template <typename Ints>
 [[gnu::always_inline]] inline bool any(Ints mask) {
+#if defined(__x86_64__)
+    if constexpr (sizeof(Ints) == 32) {  // one test instruction (assembly, as in floor_v)
+        bool some;
+        asm("vptest %1, %1" : "=@ccnz"(some) : "x"(mask));
+        return some;
+    }
+#endif
     std::int64_t words[sizeof(Ints) / 8];
     std::memcpy(words, &mask, sizeof words);
     std::int64_t all = 0;
