@@ -28,6 +28,8 @@ ResolveFilter parse_resolve_filter(const std::string& name) {
 namespace {
 
 typedef float Rgba __attribute__((vector_size(16)));  // one pixel (SSE's __m128 is this type)
+#pragma GCC diagnostic ignored "-Wpsabi"
+typedef double RgbaDouble __attribute__((vector_size(32)));  // one AVX register, or two SSE2 ones
 
 // Writes the RGBA pixels of a row of the output image past the cache where the CPU can (SSE's
 // streaming stores, for 16-byte aligned pixels). A frame's image is larger than the cache and
@@ -75,12 +77,14 @@ void resolve_tile(const SampleWindow& samples, int x0, int y0, int x1, int y1, R
         return [&, inverse, power_of_two](const float* p) {
             // The sum in double: a float sum of samples near the float maximum would overflow to
             // infinity, though their mean is finite.
-            double sum[4] = {0, 0, 0, 0};
-            for (int s = 0; s < S; ++s)
-                for (int c = 0; c < 4; ++c) sum[c] += p[4 * s + c];
-            Rgba v;
-            for (int c = 0; c < 4; ++c) v[c] = static_cast<float>(power_of_two ? sum[c] * inverse : sum[c] / S);
-            return v;
+            // (All four channels in one vector: per channel the same additions, from +0, in order.)
+            RgbaDouble sum{0, 0, 0, 0};
+            for (int s = 0; s < S; ++s) {
+                Rgba sample;
+                std::memcpy(&sample, p + 4 * s, sizeof sample);
+                sum += __builtin_convertvector(sample, RgbaDouble);
+            }
+            return __builtin_convertvector(power_of_two ? sum * inverse : sum / double(S), Rgba);
         };
     };
     if (S == 1) {
