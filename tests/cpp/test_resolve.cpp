@@ -430,4 +430,27 @@ TEST(Resolve, KeepingTheSamplesDoesNotChangeTheImage) {
     }
 }
 
+
+// "One sample per pixel runs no resolve" (render's resolve_filter): at one sample a wide filter
+// gives the box's copy, kept samples or not. (It used to reach resolve_tile with the wide filter
+// and throw "use resolve_framebuffer".)
+TEST(Resolve, OneSampleWithAWideFilterIsTheCopy) {
+    const int W = 40, H = 36;  // two tiles by two, partial at the right and bottom
+    mr::Mesh tri = fixed_triangle({100, 200}, {39 * 256 + 5, 3 * 256 + 100}, {7 * 256 + 77, 35 * 256 + 250});
+    tri.colors = {glm::vec4(1, 0, 0, 1), glm::vec4(0, 0.5f, 0, 0.5f), glm::vec4(0.1f, 0.2f, 0.3f, 0.4f)};
+    const std::vector<mr::Draw> draws = {make_draw(tri, fixed_to_ndc(W, H), no_depth(mr::BlendMode::over))};
+    auto s = settings(W, H, 1);
+    s.clear_color = glm::vec4(0.25f, 0.5f, 0.75f, 1.0f);
+    s.keep_samples = false;
+    const mr::RenderResult box = mr::render(draws, identity_camera(), s);
+    for (mr::ResolveFilter filter : {mr::ResolveFilter::tent, mr::ResolveFilter::mitchell,
+                                     mr::ResolveFilter::catmull_rom, mr::ResolveFilter::lanczos3})
+        for (bool keep : {false, true}) {
+            SCOPED_TRACE(mr::to_string(filter) + (keep ? ", samples kept" : ""));
+            s.resolve_filter = filter;
+            s.keep_samples = keep;
+            const mr::RenderResult r = mr::render(draws, identity_camera(), s);
+            EXPECT_TRUE(same_bits(r.color.pixels, box.color.pixels));
+        }
+}
 }  // namespace

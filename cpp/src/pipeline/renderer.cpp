@@ -579,8 +579,8 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 }
                 rasterize_tile_chunks(tile, chunks, kernels, inputs, part, counters);
             }
-            if (!wide_resolve)
-                resolve_tile(part.color, part.x0, part.y0, part.x1, part.y1, settings.resolve_filter, result.color);
+            if (!wide_resolve)  // (the box: at one sample every filter's resolve is this copy)
+                resolve_tile(part.color, part.x0, part.y0, part.x1, part.y1, ResolveFilter::box, result.color);
             if (settings.estimate_error)
                 estimate_tile_error(part.color, halves, part.x0, part.y0, part.x1, part.y1, result.error_map);
             if (depth_output)
