@@ -65,6 +65,7 @@ py::dict stats_dict(const RenderStats& s) {
     d["shader_invocations"] = s.shader_invocations;
     d["depth_blocks_rejected"] = s.depth_blocks_rejected;
     d["tiles_deferred"] = s.tiles_deferred;
+    d["tiles_empty"] = s.tiles_empty;
     d["threads"] = s.threads;
     d["transform_ms"] = s.transform_ms;
     d["setup_ms"] = s.setup_ms;

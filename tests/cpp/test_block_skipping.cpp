@@ -4,6 +4,8 @@
 // blend, sample mode and thread count — and it does skip blocks where a surface in front hides the rest.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <random>
@@ -179,4 +181,47 @@ TEST(BlockSkipping, AnOccluderDrawnFirstHidesEveryBlockBehindIt) {
     EXPECT_TRUE(same_bits(back_to_front.color.pixels, r.color.pixels));
 }
 
+
+// A tile no triangle reaches is written from the clear values alone (no tile buffers): the same
+// bits as the plain path's clear and resolve, depth output included, for every sample mode. The
+// clear colour has a −0 (the resolve of several samples makes it +0) and a subnormal.
+TEST(BlockSkipping, EmptyTilesGiveThePlainPathsClearAndResolve) {
+    const int W = 100, H = 70;  // 4 × 3 tiles, partial at the right and bottom
+    mr::Mesh corner = random_overlap(40, 0.6, 31);
+    for (glm::vec3& p : corner.positions) p = 0.3f * p + glm::vec3(-1.0f, 0.5f, 0.0f);  // the top left only
+    struct Mode {
+        mr::AntiAliasing aa;
+        int samples;
+    };
+    const Mode modes[] = {{mr::AntiAliasing::ssaa, 1}, {mr::AntiAliasing::ssaa, 4}, {mr::AntiAliasing::msaa, 4},
+                          {mr::AntiAliasing::ssaa, 3}, {mr::AntiAliasing::msaa, 8}};
+    for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
+        const mr::Camera cam = overlap_camera(convention, W, H);
+        const std::vector<mr::Draw> draws = {make_draw(corner, glm::dmat4(1.0), mr::DrawState{})};
+        for (const Mode& mode : modes)
+            for (int threads : {1, 2}) {
+                SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(mode.aa) + " " +
+                             std::to_string(mode.samples) + ", " + std::to_string(threads) + " threads");
+                auto s = settings(W, H, mode.samples);
+                s.anti_aliasing = mode.aa;
+                s.threads = threads;
+                s.keep_samples = false;
+                s.depth_output = true;
+                s.clear_color = glm::vec4(-0.0f, 0.3f, 1e-40f, 1.0f);
+                std::atomic<std::size_t> reports{0}, last{0};
+                s.progress = [&](std::size_t done, std::size_t) {
+                    ++reports;
+                    last = std::max(last.load(), done);
+                };
+                const auto [plain, fast] = render_off_on(draws, cam, s, &mr::RenderSettings::block_skipping);
+                EXPECT_EQ(plain.stats.tiles_empty, 0u);
+                EXPECT_GT(fast.stats.tiles_empty, 0u);
+                EXPECT_LT(fast.stats.tiles_empty, 12u);
+                expect_same_render(fast, plain);
+                EXPECT_TRUE(same_bits(fast.depth.pixels, plain.depth.pixels)) << "depth output differs";
+                EXPECT_EQ(reports.load(), 2u * 12u);  // every tile reported, in both renders
+                EXPECT_EQ(last.load(), 12u);
+            }
+    }
+}
 }  // namespace

@@ -143,7 +143,7 @@ def test_stats_and_repr():
     assert set(result.stats) == {
         "triangles_in", "triangles_clipped", "triangles_outside", "triangles_backface", "triangles_degenerate",
         "triangles_nonfinite", "triangles_rasterized", "samples_covered", "samples_passed",
-        "shader_invocations", "depth_blocks_rejected", "tiles_deferred", "threads", "transform_ms", "setup_ms", "raster_ms", "total_ms"}
+        "shader_invocations", "depth_blocks_rejected", "tiles_deferred", "tiles_empty", "threads", "transform_ms", "setup_ms", "raster_ms", "total_ms"}
     assert result.stats["triangles_in"] == sum(d.mesh.triangle_count for d in scene.draws)
     assert result.stats["threads"] == 2
     assert (result.width, result.height, result.spp, result.pattern_kind) == (32, 18, 1, "center")

@@ -246,6 +246,13 @@ void rasterize_tile_chunks(std::size_t tile, const std::vector<BinnedChunk>& chu
     }
 }
 
+// Whether any triangle's bounds reach the tile.
+bool tile_has_triangles(std::size_t tile, const std::vector<BinnedChunk>& chunks) {
+    for (const BinnedChunk& chunk : chunks)
+        if (chunk.tile_start[tile] != chunk.tile_start[tile + 1]) return true;
+    return false;
+}
+
 // About how many times over the tile's triangles cover it (binning added up each chunk's
 // tile_overlap_area).
 double tile_overdraw(std::size_t tile, const std::vector<BinnedChunk>& chunks, const TileTarget& target) {
@@ -315,6 +322,7 @@ void add_counters(const std::vector<TileCounters>& tiles, RenderStats& stats) {
         stats.shader_invocations += c.shader_invocations;
         stats.depth_blocks_rejected += c.depth_blocks_rejected;
         stats.tiles_deferred += c.tiles_deferred;
+        stats.tiles_empty += c.tiles_empty;
     }
 }
 
@@ -513,6 +521,24 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     if (settings.estimate_error) result.error_map = Image(settings.width, settings.height, 1);
     const std::vector<std::vector<PixelSpan>> spans = pixel_spans(settings.pixels, grid);
     const bool listed = !settings.pixels.empty();
+    // A tile no triangle reaches (block skipping's whole-tile case) needs no tile buffers: each of
+    // its pixels is what the resolve makes of samples that all hold the clear values, worked out
+    // once here by the same resolve on one pixel (at one sample the clear colour itself).
+    const bool skip_empty_tiles = settings.block_skipping && !whole_frame && !listed && !settings.estimate_error;
+    glm::vec4 clear_pixel(0.0f), clear_view_depth(0.0f);
+    if (skip_empty_tiles) {
+        std::vector<float> colour(4 * static_cast<std::size_t>(S)), depth(static_cast<std::size_t>(S), clear_depth);
+        for (int s = 0; s < S; ++s)
+            for (int c = 0; c < 4; ++c) colour[4 * static_cast<std::size_t>(s) + c] = settings.clear_color[c];
+        Image pixel(1, 1, 4);
+        resolve_tile({colour.data(), 4, 0, 0, 1, S}, 0, 0, 1, 1, ResolveFilter::box, pixel);
+        clear_pixel = glm::vec4(pixel.at(0, 0, 0), pixel.at(0, 0, 1), pixel.at(0, 0, 2), pixel.at(0, 0, 3));
+        if (depth_output) {
+            Image z(1, 1, 1);
+            resolve_view_depth({depth.data(), 1, 0, 0, 1, S}, 0, 0, 1, 1, clear_depth, decoder, z);
+            clear_view_depth = glm::vec4(z.at(0, 0, 0));
+        }
+    }
     std::vector<TileCounters> tile_counters(static_cast<std::size_t>(grid.count()));
     std::mutex progress_mutex;
     std::size_t tiles_done = 0;
@@ -523,6 +549,13 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         // Counted here and stored once: the kernels count per sample, and neighbouring tiles'
         // counters share cache lines, which two threads would otherwise pass back and forth.
         TileCounters counters;
+        const auto done = [&] {
+            tile_counters[tile] = counters;
+            if (settings.progress) {
+                std::lock_guard<std::mutex> lock(progress_mutex);
+                settings.progress(++tiles_done, static_cast<std::size_t>(grid.count()));
+            }
+        };
         const bool masked = !settings.tile_mask.empty() && !settings.tile_mask[tile];
         if (masked || listed) {
             // Pixels not asked for: the clear colour, no samples drawn, no error.
@@ -532,6 +565,14 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 SampleWindow{result.depth.pixels.data(), 1, 0, 0, settings.width, 1}.fill(
                     target.x0, target.y0, target.x1, target.y1, glm::vec4(std::numeric_limits<float>::infinity()));
             if (masked || spans[tile].empty()) return;
+        }
+        if (skip_empty_tiles && !tile_has_triangles(tile, chunks)) {
+            write_pixels(clear_pixel, target.x0, target.y0, target.x1, target.y1, result.color);
+            if (depth_output)
+                SampleWindow{result.depth.pixels.data(), 1, 0, 0, settings.width, 1}.fill(
+                    target.x0, target.y0, target.x1, target.y1, clear_view_depth);
+            ++counters.tiles_empty;
+            return done();
         }
         // Tile-local storage, reused by each worker thread from tile to tile.
         thread_local std::vector<float> tile_color, tile_depth;
@@ -586,11 +627,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             if (depth_output)
                 resolve_view_depth(part.depth, part.x0, part.y0, part.x1, part.y1, clear_depth, decoder, result.depth);
         }
-        tile_counters[tile] = counters;
-        if (settings.progress) {
-            std::lock_guard<std::mutex> lock(progress_mutex);
-            settings.progress(++tiles_done, static_cast<std::size_t>(grid.count()));
-        }
+        done();
     });
     if (wide_resolve) resolve_framebuffer(kept, result.pattern, settings.resolve_filter, pool, result.color);
     add_counters(tile_counters, stats);
@@ -718,7 +755,7 @@ std::string RenderStats::to_json() const {
            field("triangles_degenerate", triangles_degenerate) + field("triangles_nonfinite", triangles_nonfinite) +
            field("triangles_rasterized", triangles_rasterized) + field("samples_covered", samples_covered) +
            field("samples_passed", samples_passed) + field("shader_invocations", shader_invocations) +
-           field("depth_blocks_rejected", depth_blocks_rejected) + field("tiles_deferred", tiles_deferred) + field("threads", threads) + field("transform_ms", transform_ms) + field("setup_ms", setup_ms) +
+           field("depth_blocks_rejected", depth_blocks_rejected) + field("tiles_deferred", tiles_deferred) + field("tiles_empty", tiles_empty) + field("threads", threads) + field("transform_ms", transform_ms) + field("setup_ms", setup_ms) +
            field("raster_ms", raster_ms) + field("total_ms", total_ms, true) + "}";
 }
 
@@ -734,7 +771,7 @@ std::string RenderStats::to_string() const {
            ", rasterized=" + std::to_string(triangles_rasterized) + ", samples_covered=" + std::to_string(samples_covered) +
            ", samples_passed=" + std::to_string(samples_passed) + ", shader_invocations=" +
            std::to_string(shader_invocations) + ", depth_blocks_rejected=" + std::to_string(depth_blocks_rejected) +
-           ", tiles_deferred=" + std::to_string(tiles_deferred) +
+           ", tiles_deferred=" + std::to_string(tiles_deferred) + ", tiles_empty=" + std::to_string(tiles_empty) +
            ", threads=" + std::to_string(threads) + ", transform_ms=" +
            ms(transform_ms) + ", setup_ms=" + ms(setup_ms) + ", raster_ms=" + ms(raster_ms) +
            ", total_ms=" + ms(total_ms) + ")";

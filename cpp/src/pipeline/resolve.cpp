@@ -101,6 +101,13 @@ void resolve_tile(const SampleWindow& samples, int x0, int y0, int x1, int y1, R
     finish_rows();
 }
 
+void write_pixels(const glm::vec4& value, int x0, int y0, int x1, int y1, Image& out) {
+    Rgba v;
+    std::memcpy(&v, &value, sizeof v);
+    for (int y = y0; y < y1; ++y) write_row(&out.at(x0, y, 0), x1 - x0, [v](int) { return v; });
+    finish_rows();
+}
+
 namespace {
 
 // The 1-D weights of one axis: tap n ∈ [−reach, reach] (a neighbouring pixel) and sample s sit at

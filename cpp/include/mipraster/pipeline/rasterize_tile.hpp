@@ -111,6 +111,7 @@ struct TileCounters {
     std::uint64_t shader_invocations = 0;
     std::uint64_t depth_blocks_rejected = 0;  ///< (triangle, 8×8 block) pairs whose depth tests were skipped
     std::uint64_t tiles_deferred = 0;         ///< tiles shaded after a visibility pre-pass
+    std::uint64_t tiles_empty = 0;            ///< tiles no triangle reached: written without tile buffers
 };
 
 using TileKernel = void (*)(const TileTarget&, const DrawInputs&, const TriangleBatch&, TileCounters&);

@@ -56,8 +56,10 @@ struct RenderSettings {
     /// samples). Not with tile_mask, nor with a resolve filter wider than a pixel.
     std::vector<std::uint32_t> pixels;
     /// Per 8×8-pixel block, skip a triangle's samples where it covers none, and its depth tests
-    /// where it lies behind every depth already stored (they would all fail). The output and the
-    /// sample counters are the same either way; false runs the plain per-sample path, for comparison.
+    /// where it lies behind every depth already stored (they would all fail); a tile no triangle
+    /// reaches gets its pixels from the clear values without tile buffers to clear and resolve.
+    /// The output and the sample counters are the same either way; false runs the plain
+    /// per-sample path, for comparison.
     bool block_skipping = true;
     /// At one sample per pixel and under SSAA, a depth-tested triangle's coverage, weights and
     /// depth tests along a row of pixels run four pixels per vector (sample by sample); under MSAA
@@ -102,6 +104,9 @@ struct RenderStats {
     std::uint64_t depth_blocks_rejected = 0;
     /// Tiles shaded after a visibility pre-pass (RenderSettings::deferred_shading).
     std::uint64_t tiles_deferred = 0;
+    /// Tiles no triangle reached, written straight from the clear values without tile buffers
+    /// (RenderSettings::block_skipping).
+    std::uint64_t tiles_empty = 0;
     int threads = 1;
     double transform_ms = 0, setup_ms = 0;
     double raster_ms = 0;  ///< clear, rasterize, shade, test, blend and resolve, tile by tile

@@ -2,6 +2,8 @@
 // Resolve stage: reconstruct pixels from supersamples with a filter.
 #include <string>
 
+#include <glm/vec4.hpp>
+
 #include "mipraster/core/image.hpp"
 #include "mipraster/core/reconstruction_filter.hpp"
 #include "mipraster/core/thread_pool.hpp"
@@ -22,6 +24,10 @@ ResolveFilter parse_resolve_filter(const std::string& name);
 /// Box-resolves the pixels [x0, x1) × [y0, y1) of `samples` (RGBA windows) into `out` (H, W, 4).
 /// Only the box filter is pixel-local: another filter throws std::invalid_argument.
 void resolve_tile(const SampleWindow& samples, int x0, int y0, int x1, int y1, ResolveFilter filter, Image& out);
+
+/// Writes `value` to the pixels [x0, x1) × [y0, y1) of `out` (H, W, 4) the way resolve_tile writes
+/// its pixels (past the cache where it can): a tile with nothing drawn on it.
+void write_pixels(const glm::vec4& value, int x0, int y0, int x1, int y1, Image& out);
 
 /// Resolves a whole framebuffer with any filter: pixel (x, y) is the weighted mean of the samples
 /// of the pixels around it, sample s of pixel (x', y') at (x' + ox_s, y' + oy_s) weighing
