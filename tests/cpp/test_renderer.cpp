@@ -286,16 +286,22 @@ namespace {
 
 TEST(Renderer, ProgressReportsEveryTileOnceInIncreasingOrderEndingAtTheTotal) {
     const mr::Mesh ok = small_mesh();
-    for (int threads : {1, 3}) {
-        auto s = settings(100, 70, 4);  // 4 × 3 tiles of 32 px, the last ones partial
-        s.threads = threads;
-        std::vector<std::pair<std::size_t, std::size_t>> calls;
-        s.progress = [&](std::size_t done, std::size_t total) { calls.emplace_back(done, total); };
-        mr::render({make_draw(ok, glm::dmat4(1.0), mr::DrawState{})}, mr::Camera{}, s);
-        ASSERT_EQ(calls.size(), 12u) << threads;
-        for (std::size_t i = 0; i < calls.size(); ++i) {
-            EXPECT_EQ(calls[i].first, i + 1);
-            EXPECT_EQ(calls[i].second, 12u);
+    // Every tile drawn; half of them masked out; a few pixels listed (most tiles have none).
+    for (int part : {0, 1, 2}) {
+        for (int threads : {1, 3}) {
+            SCOPED_TRACE(std::to_string(part) + ", " + std::to_string(threads) + " threads");
+            auto s = settings(100, 70, 4);  // 4 × 3 tiles of 32 px, the last ones partial
+            s.threads = threads;
+            if (part == 1) s.tile_mask = {1, 0, 1, 0, 0, 1, 0, 1, 1, 0, 1, 0};
+            if (part == 2) s.keep_samples = false, s.pixels = {0, 5, 3 * 100 + 40};
+            std::vector<std::pair<std::size_t, std::size_t>> calls;
+            s.progress = [&](std::size_t done, std::size_t total) { calls.emplace_back(done, total); };
+            mr::render({make_draw(ok, glm::dmat4(1.0), mr::DrawState{})}, mr::Camera{}, s);
+            ASSERT_EQ(calls.size(), 12u) << threads;
+            for (std::size_t i = 0; i < calls.size(); ++i) {
+                EXPECT_EQ(calls[i].first, i + 1);
+                EXPECT_EQ(calls[i].second, 12u);
+            }
         }
     }
 }

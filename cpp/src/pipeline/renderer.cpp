@@ -564,7 +564,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
             if (depth_output)
                 SampleWindow{result.depth.pixels.data(), 1, 0, 0, settings.width, 1}.fill(
                     target.x0, target.y0, target.x1, target.y1, glm::vec4(std::numeric_limits<float>::infinity()));
-            if (masked || spans[tile].empty()) return;
+            if (masked || spans[tile].empty()) return done();
         }
         if (skip_empty_tiles && !tile_has_triangles(tile, chunks)) {
             write_pixels(clear_pixel, target.x0, target.y0, target.x1, target.y1, result.color);
