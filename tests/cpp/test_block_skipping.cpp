@@ -181,7 +181,6 @@ TEST(BlockSkipping, AnOccluderDrawnFirstHidesEveryBlockBehindIt) {
     EXPECT_TRUE(same_bits(back_to_front.color.pixels, r.color.pixels));
 }
 
-
 // A tile no triangle reaches is written from the clear values alone (no tile buffers): the same
 // bits as the plain path's clear and resolve, depth output included, for every sample mode. The
 // clear colour has a −0 (the resolve of several samples makes it +0) and a subnormal.
@@ -224,4 +223,5 @@ TEST(BlockSkipping, EmptyTilesGiveThePlainPathsClearAndResolve) {
             }
     }
 }
+
 }  // namespace
