@@ -559,8 +559,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         const bool masked = !settings.tile_mask.empty() && !settings.tile_mask[tile];
         if (masked || listed) {
             // Pixels not asked for: the clear colour, no samples drawn, no error.
-            SampleWindow image{result.color.pixels.data(), 4, 0, 0, settings.width, 1};
-            image.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
+            write_pixels(settings.clear_color, target.x0, target.y0, target.x1, target.y1, result.color);
             if (depth_output)
                 SampleWindow{result.depth.pixels.data(), 1, 0, 0, settings.width, 1}.fill(
                     target.x0, target.y0, target.x1, target.y1, glm::vec4(std::numeric_limits<float>::infinity()));
