@@ -578,3 +578,77 @@ TEST(Clip, EdgesOfTrianglesReaching1e15PixelsCrossTheViewportWhereTheyShould) {
 }
 
 }  // namespace
+
+namespace {
+
+// Triangles with a vertex 10^2…10^30 behind the eye. A crossing used to be computed from the
+// lexicographically smaller endpoint; when that was the far vertex, the crossing's w was the
+// difference of two numbers that large and came out 0 or negative (a fuzzed scene rendered NaN
+// colours from it). Each clipped vertex must lie in the clip volume, have w > 0 and be the point
+// its weights make of the triangle's vertices (the sum in long double, to 10^-9 of its terms).
+TEST(Clip, CrossingsNextToVerticesFarBehindTheEyeLieOnTheClipVolumeAndTheirEdges) {
+    const int W = 64, H = 48;
+    std::mt19937_64 rng(1234);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    int clipped = 0;
+    for (const mr::DepthConvention c : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
+        SCOPED_TRACE(mr::to_string(c));
+        const double far = c == mr::DepthConvention::reverse_z ? mr::kInfiniteFar : 100.0;
+        const glm::dmat4 proj = mr::perspective(1.0, double(W) / H, 0.01, far, c);
+        const mr::ClipVolume volume = mr::make_clip_volume(c, W, H);
+        for (int k = 0; k < 3000; ++k) {
+            // Two vertices 0.005…4 in front of the eye, one 10^2…10^30 behind it, in any order.
+            std::array<glm::dvec4, 3> p;
+            for (int i = 0; i < 3; ++i) {
+                const double d = i < 2 ? 2.0 + 1.995 * u(rng) : -std::pow(10.0, 16.0 + 14.0 * u(rng));
+                p[i] = proj * glm::dvec4(u(rng) * std::fabs(d), u(rng) * std::fabs(d), -d, 1.0);
+            }
+            std::rotate(p.begin(), p.begin() + static_cast<long>(rng() % 3), p.end());
+            const std::array<std::uint8_t, 3> codes = {mr::outcode(p[0], volume), mr::outcode(p[1], volume),
+                                                       mr::outcode(p[2], volume)};
+            mr::ClipPolygon poly;
+            if (mr::clip_triangle(p, codes, volume, poly) != mr::ClipOutcome::clipped) continue;
+            ++clipped;
+            for (int i = 0; i < poly.count; ++i) {
+                const glm::dvec4& v = poly.vertices[i].position;
+                const glm::dvec3& w = poly.vertices[i].weights;
+                ASSERT_GT(v.w, 0.0) << "case " << k << " vertex " << i;
+                const double size = std::fabs(v.x) + std::fabs(v.y) + std::fabs(v.z) + std::fabs(v.w);
+                for (const mr::ClipPlane& plane : volume.planes)
+                    ASSERT_GE(plane.distance(v), -1e-9 * size) << "case " << k << " vertex " << i;
+                for (int j = 0; j < 4; ++j) {
+                    long double sum = 0, terms = 0;
+                    for (int m = 0; m < 3; ++m) {
+                        sum += static_cast<long double>(w[m]) * p[m][j];
+                        terms += std::fabs(static_cast<long double>(w[m]) * p[m][j]);
+                    }
+                    ASSERT_LE(std::fabs(static_cast<double>(sum - v[j])), 1e-9 * static_cast<double>(terms) + 1e-300)
+                        << "case " << k << " vertex " << i << " coordinate " << j;
+                }
+            }
+        }
+    }
+    EXPECT_GT(clipped, 5000);
+}
+
+// The fuzzed scene itself: a camera at the origin (to subnormal offsets) looking along the
+// triangle's plane, so the triangle projects to a line, one vertex 10^20 behind the eye. It covers
+// nothing; vertex colours came out NaN on 32 pixels of 64.
+TEST(Clip, ATriangleInAPlaneThroughTheEyeReachingFarBehindItDrawsNothing) {
+    const mr::Camera cam = mr::Camera::look_at_perspective({9.54368e-41, 7.20267e-43, 2.26001e-41},
+                                                           {2.26001e-41, 2.26001e-41, 2.26001e-41}, {0.0, 1.0, 0.0},
+                                                           1.0471975511965976, 1.0, 0.01);
+    for (const double y : {-1e16, -1e20, -2.4e24, -1e30}) {
+        mr::Mesh m;
+        m.positions = {{-0.5f, -0.5f, 0.0f}, {0.5f, static_cast<float>(y), 0.0f}, {0.0f, 0.5f, 0.0f}};
+        m.colors = {{1, 0, 0, 1}, {0, 1, 0, 1}, {0, 0, 1, 1}};
+        add_triangle(m, 0, 1, 2);
+        mr::DrawState st = no_depth(mr::BlendMode::add);
+        st.cull = mr::CullMode::none;
+        const mr::RenderResult r = mr::render({make_draw(m, glm::dmat4(1.0), st)}, cam, settings(8, 8));
+        EXPECT_EQ(r.stats.samples_covered, 0u) << "y = " << y;
+        for (const float v : r.color.pixels) ASSERT_EQ(v, 0.0f) << "y = " << y;
+    }
+}
+
+}  // namespace

@@ -34,13 +34,17 @@ bool lexicographically_less(const glm::dvec4& a, const glm::dvec4& b) {
     return false;
 }
 
-// The point where edge (a, b) crosses the plane, always computed from the lexicographically
-// smaller endpoint so that (a, b) and (b, a) give the same bits. Position and weights are
-// computed in long double and rounded once: an endpoint 10^15 px away has a double ulp of 1/8 px,
-// and a + t·(b − a) in double would move the crossing that far off the edge's line (stress suite,
+// The point where edge (a, b) crosses the plane, always computed from the endpoint nearer the
+// plane (on a tie, the lexicographically smaller) so that (a, b) and (b, a) give the same bits.
+// From the far endpoint, a crossing next to a vertex 10^20 behind the eye came out as the
+// difference of two numbers of 10^19, rounded to w = 0. Position and weights are computed in long
+// double and rounded once: an endpoint 10^15 px away has a double ulp of 1/8 px, and
+// a + t·(b − a) in double would move the crossing that far off the edge's line (stress suite,
 // case 3); the crossing itself lies near the guard band, where double is ample.
 ClipVertex intersect(const ClipVertex& a, double da, const ClipVertex& b, double db) {
-    if (lexicographically_less(b.position, a.position)) return intersect(b, db, a, da);
+    const double near_a = std::fabs(da), near_b = std::fabs(db);
+    if (near_b < near_a || (near_b == near_a && lexicographically_less(b.position, a.position)))
+        return intersect(b, db, a, da);
     using Wide = long double;
     const Wide t = Wide(da) / (Wide(da) - Wide(db));
     ClipVertex out;

@@ -67,11 +67,14 @@ inline ScreenVertex project_vertex(const glm::dvec4& p, const Viewport& viewport
     const double z = p.z * inv_w;
     ScreenVertex v;
     v.depth = viewport.depth_convention == DepthConvention::opengl ? 0.5 * z + 0.5 : z;
-    // Only finite, in-range values may be converted to integers.
-    if (!(std::fabs(xs) <= limit && std::fabs(ys) <= limit && std::isfinite(v.depth) && std::isfinite(inv_w))) return v;
+    // Only finite, in-range values may be converted to integers. Clipping keeps w ≥ kMinClipW, so
+    // 1/w is positive and fits a float; a vertex that breaks this is not projected.
+    v.inv_w = static_cast<float>(inv_w);
+    if (!(std::fabs(xs) <= limit && std::fabs(ys) <= limit && std::isfinite(v.depth) && inv_w > 0.0 &&
+          std::isfinite(v.inv_w)))
+        return v;
     v.x = static_cast<std::int32_t>(xs);
     v.y = static_cast<std::int32_t>(ys);
-    v.inv_w = static_cast<float>(inv_w);
     v.valid = true;
     return v;
 }
