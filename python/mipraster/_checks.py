@@ -6,6 +6,7 @@ number or a value out of range. Messages name the argument, what was expected an
 """
 from __future__ import annotations
 
+import math
 import operator
 from typing import Any, Mapping, Optional, Sequence, Tuple, TypeVar
 
@@ -129,6 +130,8 @@ def matrix(value: Any, name: str, rows: int, columns: int) -> np.ndarray:
 
 def rgba(value: Any, name: str) -> Tuple[float, float, float, float]:
     """A colour of 3 (alpha 1) or 4 finite components."""
+    if type(value) in (tuple, list) and len(value) in (3, 4) and all(type(c) is float and math.isfinite(c) for c in value):
+        return (value[0], value[1], value[2], value[3] if len(value) == 4 else 1.0)  # (a render's common case, fast)
     a = vector(value, name, (3, 4))
     if a.shape[0] == 3:
         a = np.append(a, 1.0)
@@ -161,10 +164,9 @@ def flag(value: Any, name: str) -> bool:
 
 def choice(value: Any, name: str, options: Mapping[str, E]) -> E:
     """The option named ``value``; ValueError listing the accepted names otherwise."""
+    if isinstance(value, str) and value in options:
+        return options[value]
     accepted = ", ".join(repr(k) for k in options)
     if not isinstance(value, str):
         raise TypeError(f"{name}: expected one of {accepted}, got {type(value).__name__} {value!r}")
-    try:
-        return options[value]
-    except KeyError:
-        raise ValueError(f"{name}: unknown value {value!r}; expected one of {accepted}") from None
+    raise ValueError(f"{name}: unknown value {value!r}; expected one of {accepted}")

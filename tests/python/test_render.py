@@ -286,6 +286,9 @@ def test_scene_add_refuses_wrong_types(kwargs, words):
         (dict(aa="fxaa"), "aa: unknown value 'fxaa'; expected one of 'ssaa', 'msaa'"),
         (dict(pattern="poisson"), "pattern: unknown value 'poisson'; expected one of 'auto', 'center', 'grid'"),
         (dict(clear_color=(0, 0)), "clear_color"),
+        (dict(clear_color=(0.0, float("nan"), 0.0)), "clear_color[1] is nan; expected a finite number"),
+        (dict(clear_color=[0.0, 0.0, 0.0, float("inf")]), "clear_color[3] is inf; expected a finite number"),
+        (dict(clear_color=[0.0] * 5), "clear_color: expected shape (3,) or (4,), got (5,)"),
     ],
 )
 def test_render_refuses_bad_settings_with_value_error(kwargs, message):
