@@ -414,3 +414,69 @@ TEST(Renderer, StatsJsonHoldsEveryCounter) {
 }
 
 }  // namespace
+
+namespace {
+
+// Clip space is homogeneous: a projection times a power of two 2^k draws the same image, and in
+// floating point every step scales exactly (clipping, x/w, z/w, the ratios of 1/w), so bit for
+// bit. 1/w used to be stored as a float as it came: from k ≈ 127 on it was subnormal there (other
+// bits), and from k ≈ 150 zero at every vertex (NaN colours).
+TEST(Renderer, AProjectionScaledByAPowerOfTwoDrawsTheSameBits) {
+    const int W = 64, H = 48;
+    const mr::Mesh mesh = overlapping(40, 1.2, 99);
+    for (const mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
+        const mr::Camera cam = overlap_camera(convention, W, H);
+        glm::dmat4 shifted(1.0);
+        shifted[3] = glm::dvec4(0.3, 0.1, -0.4, 1.0);
+        std::vector<mr::Draw> draws = {make_draw(mesh, glm::dmat4(1.0), mr::DrawState()),
+                                       make_draw(mesh, shifted, mr::DrawState())};
+        draws[1].texture = checker_texture();
+        mr::RenderSettings s = settings(W, H, 4);
+        s.depth_output = true;
+        const mr::RenderResult base = mr::render(draws, cam, s);
+        ASSERT_GT(base.stats.triangles_clipped, 0u);
+        ASSERT_GT(base.stats.samples_passed, std::uint64_t{W} * H);
+        for (const int k : {-60, 40, 127, 140, 150, 300, 900}) {
+            SCOPED_TRACE(mr::to_string(convention) + ", 2^" + std::to_string(k));
+            const mr::Camera scaled = mr::Camera::from_matrices(cam.view, std::ldexp(1.0, k) * cam.projection, convention);
+            const mr::RenderResult r = mr::render(draws, scaled, s);
+            expect_same_render(r, base);
+            EXPECT_TRUE(same_bits(r.depth.pixels, base.depth.pixels)) << "view depth differs";
+        }
+    }
+}
+
+// 1/w of a vertex 3·10^45 times farther than another is below float's range after the scaling
+// above; raised to the smallest normal float, samples on the far edge (where the near vertex's
+// weight is exactly 0) still get the far vertices' mix, not 0/0.
+TEST(Renderer, SamplesOnTheFarEdgeOfATriangle10To45DeepGetTheFarVerticesColours) {
+    // clip = (x, y, z/2, z): reverse-Z depth ½ everywhere, w = z.
+    glm::dmat4 projection(0.0);
+    projection[0][0] = projection[1][1] = 1.0;
+    projection[2][2] = 0.5;
+    projection[2][3] = 1.0;
+    const mr::Camera cam = mr::Camera::from_matrices(glm::dmat4(1.0), projection, mr::DepthConvention::reverse_z);
+    const float far = 3e38f, near = 1e-7f;
+    mr::Mesh m;
+    // Far edge at NDC y = 1/8: pixel row 3's centres (y = 3.5 px at H = 8), a top edge, so they are inside.
+    m.positions = {{0.0f, -0.9f * near, near}, {-0.9f * far, far / 8, far}, {0.9f * far, far / 8, far}};
+    m.colors = {{0, 0, 1, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}};
+    add_triangle(m, 0, 1, 2);
+    mr::DrawState st = no_depth();
+    st.cull = mr::CullMode::none;
+    const mr::RenderResult r = mr::render({make_draw(m, glm::dmat4(1.0), st)}, cam, settings(8, 8));
+    ASSERT_GT(r.stats.samples_covered, 8u);
+    for (int x = 0; x < 8; ++x)
+        for (int y = 0; y < 8; ++y)
+            for (int c = 0; c < 4; ++c) ASSERT_TRUE(std::isfinite(r.color.at(x, y, c))) << x << ", " << y;
+    int far_edge = 0;
+    for (int x = 0; x < 8; ++x) {  // the edge runs from x = 0.4 to 7.6 px
+        if (r.color.at(x, 3, 3) == 0.0f) continue;
+        ++far_edge;
+        EXPECT_NEAR(r.color.at(x, 3, 0) + r.color.at(x, 3, 1), 1.0f, 1e-6f) << x;
+        EXPECT_EQ(r.color.at(x, 3, 2), 0.0f) << x;
+    }
+    EXPECT_EQ(far_edge, 8);
+}
+
+}  // namespace

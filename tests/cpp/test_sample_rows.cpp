@@ -204,7 +204,7 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
             const int jitter = trial % 2 ? static_cast<int>(rng() % 256) - 128 : 0;
             vertex = {static_cast<std::int32_t>(px * mr::kSubpixelOne + 128 + jitter),
                       static_cast<std::int32_t>(py * mr::kSubpixelOne + 128 - jitter),
-                      static_cast<float>(0.3 + 2.0 * unit(rng)), true, unit(rng)};
+                      0.3 + 2.0 * unit(rng), unit(rng)};
         }
         mr::SetupTriangle t;
         mr::SetupCounters counters;

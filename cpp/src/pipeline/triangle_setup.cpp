@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 
 #include "mipraster/core/constants.hpp"
 
@@ -26,7 +28,7 @@ bool setup_triangle(const std::array<glm::dvec4, 3>& p, const Viewport& viewport
 bool setup_triangle(const std::array<ScreenVertex, 3>& v, const Viewport& viewport, CullMode cull, SetupTriangle& out,
                     SetupCounters& counters) {
     // Step 1: the projected, snapped vertices.
-    if (!(v[0].valid && v[1].valid && v[2].valid)) {
+    if (!(v[0].valid() && v[1].valid() && v[2].valid())) {
         ++counters.dropped_nonfinite;
         return false;
     }
@@ -80,7 +82,21 @@ bool setup_triangle(const std::array<ScreenVertex, 3>& v, const Viewport& viewpo
     out.z0 = v[0].depth;
     out.dz1 = v[1].depth - v[0].depth;
     out.dz2 = v[2].depth - v[0].depth;
-    for (int i = 0; i < 3; ++i) out.inv_w[i] = v[i].inv_w;
+    // 1/w enters only ratios (perspective weights, uv and its derivatives), so the three values are
+    // scaled by the power of two that brings the largest to [1, 2). That is exact: where 1/w fits a
+    // float nothing changes, and where it does not the values stay in range (a camera matrix scaled
+    // by 10^46 gave 1/w = 0 at every vertex, and NaN colours). A value below float's normal range (a vertex 2^126
+    // times farther than another) is raised to its smallest, so that Σ λ_i/w_i > 0 at every sample.
+    const double largest = std::max({v[0].inv_w, v[1].inv_w, v[2].inv_w});
+    std::uint64_t bits;
+    std::memcpy(&bits, &largest, sizeof bits);
+    // largest = m·2^(E − 1023), m ∈ [1, 2), with E its exponent field; the scale 2^(1023 − E) has
+    // the field 2046 − E, which is ≥ 1 (a normal double) because largest = 1/w < 2^1023.
+    bits = (2046 - (bits >> 52)) << 52;
+    double scale;
+    std::memcpy(&scale, &bits, sizeof scale);
+    for (int i = 0; i < 3; ++i)
+        out.inv_w[i] = std::max(static_cast<float>(v[i].inv_w * scale), std::numeric_limits<float>::min());
     return true;
 }
 

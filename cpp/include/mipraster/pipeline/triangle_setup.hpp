@@ -24,7 +24,7 @@ struct SetupTriangle {
     std::int32_t min_x, min_y, max_x, max_y;  ///< inclusive pixel bounds, inside the viewport
     double inv_area2;                         ///< 1 / (twice the area in 1/256² px²)
     double z0, dz1, dz2;                      ///< depth = z0 + λ1·dz1 + λ2·dz2 (window depth), rounded to float once
-    std::array<float, 3> inv_w;               ///< 1/w at each vertex
+    std::array<float, 3> inv_w;               ///< 1/w at each vertex, times a power of two (see setup_triangle)
     std::int32_t clip_index;                  ///< −1, or which clipped-weights entry maps vertices to the original
     std::uint32_t triangle;                   ///< index of the original triangle within its draw
     std::uint32_t draw;                       ///< index of the draw
@@ -44,14 +44,16 @@ struct Viewport {
 };
 
 /// A clip-space vertex on the screen: its position snapped to 1/256 px (y down), its window depth
-/// and 1/w. `valid` is false when a projected coordinate is not finite or beyond
-/// kMaxFixedCoordinate; the other fields are then meaningless.
+/// and 1/w. Not valid (inv_w = 0) when a projected coordinate is not finite or beyond
+/// kMaxFixedCoordinate, or 1/w is not a positive normal double; the other fields are then
+/// meaningless. (24 bytes: setup reads three per triangle.)
 struct ScreenVertex {
     std::int32_t x = 0, y = 0;
-    float inv_w = 0.0f;
-    bool valid = false;
+    double inv_w = 0.0;
     double depth = 0.0;
+    bool valid() const { return inv_w > 0.0; }
 };
+static_assert(sizeof(ScreenVertex) == 24);
 
 /// Projects and snaps one clip-space vertex. A vertex shared by several triangles is projected
 /// once: the result is the same whichever triangle asks. (Inline: returned through memory, the
@@ -68,14 +70,13 @@ inline ScreenVertex project_vertex(const glm::dvec4& p, const Viewport& viewport
     ScreenVertex v;
     v.depth = viewport.depth_convention == DepthConvention::opengl ? 0.5 * z + 0.5 : z;
     // Only finite, in-range values may be converted to integers. Clipping keeps w ≥ kMinClipW, so
-    // 1/w is positive and fits a float; a vertex that breaks this is not projected.
-    v.inv_w = static_cast<float>(inv_w);
+    // 1/w is positive; a vertex that breaks this is not projected.
     if (!(std::fabs(xs) <= limit && std::fabs(ys) <= limit && std::isfinite(v.depth) && inv_w > 0.0 &&
-          std::isfinite(v.inv_w)))
+          std::isnormal(inv_w)))
         return v;
     v.x = static_cast<std::int32_t>(xs);
     v.y = static_cast<std::int32_t>(ys);
-    v.valid = true;
+    v.inv_w = inv_w;
     return v;
 }
 
