@@ -295,6 +295,12 @@ ClipScene near_plane_scene(int width, int samples) {
         {glm::dvec4(0.5, 0.5, -2e-300, 1e-300), glm::dvec4(-0.5, 0.4, 0.9, 1.0), glm::dvec4(0.0, -0.7, -1.5, 1.0)},
         // A triangle whose plane passes through the eye (seen edge-on): a line on screen.
         {glm::dvec4(0.0, 0.0, 0.0, 1.0), glm::dvec4(0.0, 0.0, 0.5, 2.0), glm::dvec4(0.5, 0.0, 0.0, 1.0)},
+        // One vertex 10^20 behind the eye: the crossings next to it are rounded at its scale
+        // unless computed from the endpoint nearer the plane.
+        {glm::dvec4(-0.4e20, 0.3e20, 0.5e20, -1e20), glm::dvec4(-0.6, -0.5, 0.1, 1.0), glm::dvec4(0.7, -0.4, 0.3, 1.2)},
+        // Every w near 10^46 (an ordinary triangle times 10^46): 1/w is below float's range.
+        {glm::dvec4(0.3e46, 0.2e46, 0.1e46, 1e46), glm::dvec4(-0.5e46, -0.4e46, 0.2e46, 1.5e46),
+         glm::dvec4(0.6e46, -0.5e46, 0.6e46, 2e46)},
     };
     for (const auto& t : tris) {
         const std::uint32_t first = static_cast<std::uint32_t>(sc.clip.size());
