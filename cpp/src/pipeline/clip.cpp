@@ -42,8 +42,8 @@ bool lexicographically_less(const glm::dvec4& a, const glm::dvec4& b) {
 // a + t·(b − a) in double would move the crossing that far off the edge's line (stress suite,
 // case 3); the crossing itself lies near the guard band, where double is ample.
 ClipVertex intersect(const ClipVertex& a, double da, const ClipVertex& b, double db) {
-    const double near_a = std::fabs(da), near_b = std::fabs(db);
-    if (near_b < near_a || (near_b == near_a && lexicographically_less(b.position, a.position)))
+    const double off_a = std::fabs(da), off_b = std::fabs(db);  // distances from the plane
+    if (off_b < off_a || (off_b == off_a && lexicographically_less(b.position, a.position)))
         return intersect(b, db, a, da);
     using Wide = long double;
     const Wide t = Wide(da) / (Wide(da) - Wide(db));

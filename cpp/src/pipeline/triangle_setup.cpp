@@ -85,8 +85,9 @@ bool setup_triangle(const std::array<ScreenVertex, 3>& v, const Viewport& viewpo
     // 1/w enters only ratios (perspective weights, uv and its derivatives), so the three values are
     // scaled by the power of two that brings the largest to [1, 2). That is exact: where 1/w fits a
     // float nothing changes, and where it does not the values stay in range (a camera matrix scaled
-    // by 10^46 gave 1/w = 0 at every vertex, and NaN colours). A value below float's normal range (a vertex 2^126
-    // times farther than another) is raised to its smallest, so that Σ λ_i/w_i > 0 at every sample.
+    // by 10^46 gave 1/w = 0 at every vertex, and NaN colours). A value below float's normal range
+    // (a vertex 2^126 times farther than another) is raised to its smallest, so that Σ λ_i/w_i > 0
+    // at every sample.
     const double largest = std::max({v[0].inv_w, v[1].inv_w, v[2].inv_w});
     std::uint64_t bits;
     std::memcpy(&bits, &largest, sizeof bits);

@@ -85,7 +85,8 @@ std::vector<StressRow> stress_near_plane(StressSize size) {
                                                          2 * !finite2(q.uv.uv) + 2 * !finite2(q.uv.dx) + 2 * !finite2(q.uv.dy);
                                         });
     row.tried = std::to_string(sc.triangles.size()) + " triangles in OpenGL clip space: w = 1e-12, 0, < 0 (one and two "
-                "vertices), all behind, grazing the near plane, w = 1e-300, edge-on, a vertex 1e20 behind, w ~ 1e46; " + std::to_string(W) + "^2, S=4";
+                "vertices), all behind, grazing the near plane, w = 1e-300, edge-on, a vertex 1e20 behind, w ~ 1e46; " +
+                std::to_string(W) + "^2, S=4";
     row.figure = count(differences - unexplained) + " of " + count(samples) + " samples differ from the ray cast within " +
                  "2/256 px of its edge, " + count(unexplained) + " beyond; " + count(nonfinite) + " non-finite of " +
                  count(values) + " depth, weight, uv and derivative values (" + count(probed) + " samples probed)";
