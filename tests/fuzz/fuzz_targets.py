@@ -119,8 +119,15 @@ def render(data: bytes) -> bool:
         texture = mr.Texture(texels, name="fuzz") if uvs is not None else None
         sampler = mr.Sampler(**sampler_args) if texture is not None else None
         scene.add(mesh, texture=texture, sampler=sampler, cull=("none", "back", "front")[r.u8() % 3])
-        camera = mr.Camera.look_at(eye, target) if r.u8() % 2 else mr.Camera.orthographic(eye, target)
-        result = mr.render(scene, camera, width, height, spp=spp, aa=aa, threads=1 + r.u8() % 2)
+        kind, threads = r.u8(), 1 + r.u8() % 2
+        # Raw matrices (a projection of any scale, w of either sign) when the byte after the
+        # older fields asks for them: the seeds from before them read as they did.
+        if r.u8() % 2:
+            view, projection = r.floats(16).reshape(4, 4), r.floats(16).reshape(4, 4)
+            camera = mr.Camera.from_matrices(view, projection, ("opengl", "reverse_z")[r.u8() % 2])
+        else:
+            camera = mr.Camera.look_at(eye, target) if kind % 2 else mr.Camera.orthographic(eye, target)
+        result = mr.render(scene, camera, width, height, spp=spp, aa=aa, threads=threads)
         assert result.color.shape == (height, width, 4)
         # Shading multiplies texel by vertex colour, and the texture premultiplies each texel's
         # colour by its alpha: only where colour × texel × alpha fits in a float is an infinite
