@@ -528,8 +528,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     glm::vec4 clear_pixel(0.0f), clear_view_depth(0.0f);
     if (skip_empty_tiles) {
         std::vector<float> colour(4 * static_cast<std::size_t>(S)), depth(static_cast<std::size_t>(S), clear_depth);
-        for (int s = 0; s < S; ++s)
-            for (int c = 0; c < 4; ++c) colour[4 * static_cast<std::size_t>(s) + c] = settings.clear_color[c];
+        SampleWindow{colour.data(), 4, 0, 0, 1, S}.fill(0, 0, 1, 1, settings.clear_color);
         Image pixel(1, 1, 4);
         resolve_tile({colour.data(), 4, 0, 0, 1, S}, 0, 0, 1, 1, ResolveFilter::box, pixel);
         clear_pixel = glm::vec4(pixel.at(0, 0, 0), pixel.at(0, 0, 1), pixel.at(0, 0, 2), pixel.at(0, 0, 3));
@@ -556,20 +555,21 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 settings.progress(++tiles_done, static_cast<std::size_t>(grid.count()));
             }
         };
+        // The tile's pixels written with one colour and one view depth, without drawing.
+        const auto write_tile = [&](const glm::vec4& colour, const glm::vec4& view_depth) {
+            write_pixels(colour, target.x0, target.y0, target.x1, target.y1, result.color);
+            if (depth_output)
+                SampleWindow{result.depth.pixels.data(), 1, 0, 0, settings.width, 1}.fill(
+                    target.x0, target.y0, target.x1, target.y1, view_depth);
+        };
         const bool masked = !settings.tile_mask.empty() && !settings.tile_mask[tile];
         if (masked || listed) {
             // Pixels not asked for: the clear colour, no samples drawn, no error.
-            write_pixels(settings.clear_color, target.x0, target.y0, target.x1, target.y1, result.color);
-            if (depth_output)
-                SampleWindow{result.depth.pixels.data(), 1, 0, 0, settings.width, 1}.fill(
-                    target.x0, target.y0, target.x1, target.y1, glm::vec4(std::numeric_limits<float>::infinity()));
+            write_tile(settings.clear_color, glm::vec4(std::numeric_limits<float>::infinity()));
             if (masked || spans[tile].empty()) return done();
         }
         if (skip_empty_tiles && !tile_has_triangles(tile, chunks)) {
-            write_pixels(clear_pixel, target.x0, target.y0, target.x1, target.y1, result.color);
-            if (depth_output)
-                SampleWindow{result.depth.pixels.data(), 1, 0, 0, settings.width, 1}.fill(
-                    target.x0, target.y0, target.x1, target.y1, clear_view_depth);
+            write_tile(clear_pixel, clear_view_depth);
             ++counters.tiles_empty;
             return done();
         }
