@@ -2,7 +2,8 @@
 // (anisotropic footprints of several probes included) within batch_sampling_tolerance, every other
 // lane (a sampler outside covers(), a non-finite uv or derivative) bit for bit; constant textures
 // exact (DESIGN.md §2.6); a lane independent of the rest of its batch; λ reading the levels it
-// names (oracle bilinear on view.level(k)); levels built only when a lookup needs them.
+// names (oracle bilinear on view.level(k)); levels built only when a lookup needs them (and never
+// for a prefetch); the prefetched texel area holding every texel a lookup in its box reads.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -662,6 +663,80 @@ TEST(BatchSampler, BuildsOnlyTheLevelsItsLookupsNeed) {
         }
         EXPECT_EQ(tex.built_levels(), 1) << "after lookups at exactly λ = 1, " << str(s);
     }
+}
+
+// A prefetch is a hint: it builds no level, whatever it is asked for.
+TEST(BatchSampler, PrefetchBuildsNoLevel) {
+    mr::Texture tex(to::random_level(256, 128, 6100), "fresh");
+    mr::TextureView view(tex);
+    mr::Sampler s;
+    mr::BatchSampler batch_sampler(view, s);
+    for (double lambda : {0.0, 0.5, 1.0, 2.5, 7.0, 8.0, 1e30, -1e30, double(kInf), double(kNaN)})
+        for (glm::dvec2 lo : {glm::dvec2(0.1, 0.2), glm::dvec2(-5.0, 0.9), glm::dvec2(kNaN, 0.0)})
+            batch_sampler.prefetch(lo, lo + glm::dvec2(0.3, 2.0), lambda);
+    EXPECT_EQ(tex.built_levels(), 0);
+}
+
+// texel_area against the texels a bilinear lookup reads, worked out here in double: x = u·w − ½
+// (u's fraction under repeat, u·w bounded to [−2, w + 2] under clamp), texels ⌊x⌋ and ⌊x⌋ + 1,
+// wrapped or clamped. Every lookup in a random box reads texels inside the area, and the area
+// is no longer along an axis than the box's span plus five texels (or the whole axis).
+TEST(TexelArea, HoldsEveryTexelALookupInItsBoxReads) {
+    std::mt19937_64 rng(6200);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const auto read = [](double u, int n, mr::WrapMode mode, int& first, int& second) {
+        const double x = mode == mr::WrapMode::repeat ? (u - std::floor(u)) * n - 0.5
+                                                      : std::clamp(u * n, -2.0, n + 2.0) - 0.5;
+        const long i = static_cast<long>(std::floor(x));
+        const auto fix = [&](long k) {
+            return static_cast<int>(mode == mr::WrapMode::repeat ? (k % n + n) % n : std::clamp<long>(k, 0, n - 1));
+        };
+        first = fix(i), second = fix(i + 1);
+    };
+    const auto inside = [](int k, int ranges, const int (&from)[2], const int (&to)[2]) {
+        for (int r = 0; r < ranges; ++r)
+            if (k >= from[r] && k <= to[r]) return true;
+        return false;
+    };
+    const auto length = [](int ranges, const int (&from)[2], const int (&to)[2]) {
+        long n = 0;
+        for (int r = 0; r < ranges; ++r) n += to[r] - from[r] + 1;
+        return n;
+    };
+    const int sizes[] = {1, 2, 3, 7, 64, 100, 1024};
+    const double spans[] = {0.0, 1e-4, 0.01, 0.3, 0.99, 1.0, 2.5};
+    for (int trial = 0; trial < 20000; ++trial) {
+        const int w = sizes[rng() % 7], h = sizes[rng() % 7];
+        const mr::WrapMode wu = rng() % 2 ? mr::WrapMode::repeat : mr::WrapMode::clamp;
+        const mr::WrapMode wv = rng() % 2 ? mr::WrapMode::repeat : mr::WrapMode::clamp;
+        const glm::dvec2 lo(6 * unit(rng) - 3, 6 * unit(rng) - 3);
+        const glm::dvec2 hi = lo + glm::dvec2(spans[rng() % 7], spans[rng() % 7]);
+        const mr::TexelArea a = mr::texel_area(w, h, lo, hi, wu, wv);
+        ASSERT_TRUE(a.columns >= 1 && a.rows >= 1);
+        const long columns = length(a.columns, a.x_from, a.x_to), rows = length(a.rows, a.y_from, a.y_to);
+        EXPECT_LE(columns, std::min<double>(w, (hi.x - lo.x) * w + 5)) << w << " wide, " << lo.x << " … " << hi.x;
+        EXPECT_LE(rows, std::min<double>(h, (hi.y - lo.y) * h + 5)) << h << " high, " << lo.y << " … " << hi.y;
+        for (int k = 0; k < 20; ++k) {
+            // The box's corners, then points inside it.
+            const glm::dvec2 t = k < 4 ? glm::dvec2(k & 1, k >> 1) : glm::dvec2(unit(rng), unit(rng));
+            const glm::dvec2 uv = lo + t * (hi - lo);
+            int x[2], y[2];
+            read(uv.x, w, wu, x[0], x[1]);
+            read(uv.y, h, wv, y[0], y[1]);
+            for (int i = 0; i < 2; ++i) {
+                ASSERT_TRUE(inside(x[i], a.columns, a.x_from, a.x_to))
+                    << "column " << x[i] << " of " << w << " at u " << uv.x << ", box " << lo.x << " … " << hi.x;
+                ASSERT_TRUE(inside(y[i], a.rows, a.y_from, a.y_to))
+                    << "row " << y[i] << " of " << h << " at v " << uv.y << ", box " << lo.y << " … " << hi.y;
+            }
+        }
+    }
+    for (glm::dvec2 lo : {glm::dvec2(kNaN, 0.0), glm::dvec2(0.0, -double(kInf)), glm::dvec2(-0x1p21, 0.0)}) {
+        const mr::TexelArea a = mr::texel_area(64, 64, lo, glm::dvec2(0.5), mr::WrapMode::repeat, mr::WrapMode::repeat);
+        EXPECT_EQ(a.columns + a.rows, 0) << lo.x << ", " << lo.y;
+    }
+    EXPECT_EQ(mr::texel_area(64, 64, {0.6, 0.0}, {0.5, 1.0}, mr::WrapMode::clamp, mr::WrapMode::clamp).rows, 0)
+        << "an inverted box";
 }
 
 }  // namespace

@@ -6,12 +6,14 @@
 // them in. Blends read the target when they run, so a sample queued twice (by two triangles)
 // still sees the first result under the second.
 #include <cstdint>
+#include <limits>
 
 #include <glm/vec4.hpp>
 
 #include "mipraster/pipeline/blend.hpp"
 #include "mipraster/pipeline/rasterize_tile.hpp"
 #include "mipraster/pipeline/shade_texture.hpp"
+#include "mipraster/texture/sample.hpp"
 #include "mipraster/texture/sample_batch.hpp"
 #include "interpolate_batch.hpp"
 #include "sample_shading.hpp"
@@ -35,6 +37,36 @@ public:
         triangles_[current_] = {&t, clip_weights, colors, uvs,
                                 interpolates_in_batches(draw_, kShading, kTexturing, t),
                                 batch_shading(kShading, colors)};
+    }
+
+    /// Asks for the texels triangle t reads in pixels [x0, x1) × [y0, y1) to be brought into the
+    /// cache before its samples there are queued (see BatchSampler::prefetch). The area is
+    /// bounded by the uvs at the four corner pixels (the planes extended beyond the triangle, as
+    /// for quad derivatives) and by its vertices' uvs; its λ is the finest of the corners'.
+    void prefetch_area(const SetupTriangle& t, const TriangleUvs& uvs, int x0, int y0, int x1, int y1) {
+        glm::dvec2 lo = glm::min(glm::min(uvs.v[0], uvs.v[1]), uvs.v[2]);
+        glm::dvec2 hi = glm::max(glm::max(uvs.v[0], uvs.v[1]), uvs.v[2]);
+        glm::dvec2 corners_lo(std::numeric_limits<double>::infinity()), corners_hi = -corners_lo;
+        double lambda = std::numeric_limits<double>::infinity();
+        for (const int py : {y0, y1 - 1})
+            for (const int px : {x0, x1 - 1}) {
+                const std::int64_t X = std::int64_t{px} * kSubpixelOne + kSubpixelOne / 2;
+                const std::int64_t Y = std::int64_t{py} * kSubpixelOne + kSubpixelOne / 2;
+                std::int64_t e[3];
+                for (int i = 0; i < 3; ++i) e[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+                const glm::dvec3 l = screen_weights(t, e[0], e[1], e[2]);
+                // Beyond the triangle's horizon (1/w ≤ 0 there) the extended planes mean nothing.
+                if (draw_.uv_interpolation == Interpolation::perspective &&
+                    !(l.x * t.inv_w[0] + l.y * t.inv_w[1] + l.z * t.inv_w[2] > 0.0))
+                    return;
+                const UvSample s = texture_lookup<kTexturing>(draw_, t, uvs, l, px, py);
+                corners_lo = glm::min(corners_lo, s.uv), corners_hi = glm::max(corners_hi, s.uv);
+                double corner_lambda = 0.0;  // (a sampler without derivatives reads level 0)
+                if constexpr (kTexturing == Texturing::lod)
+                    corner_lambda = texture_lod(*draw_.texture, *draw_.sampler, glm::vec2(s.dx), glm::vec2(s.dy));
+                lambda = std::min(lambda, corner_lambda);
+            }
+        sampler_.prefetch(glm::max(lo, corners_lo), glm::min(hi, corners_hi), lambda);
     }
 
     /// Queues the shade of samples `samples` (a bit mask) at 4-float colour slots of `target`:

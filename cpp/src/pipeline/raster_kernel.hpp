@@ -81,6 +81,11 @@ inline bool queues_lookups(const DrawInputs& draw) {
     return kTexturing != Texturing::none && draw.batched_lookups && draw.debug_view == DebugView::none;
 }
 
+// A textured triangle whose bounds hold this many pixels of a tile or more has the texels it reads
+// there prefetched (LookupQueue::prefetch_area) as it starts; a smaller one reads few texels, and
+// the prefetch would cost more than the misses it saves.
+inline constexpr int kPrefetchArea = 256;
+
 template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode, Texturing kTexturing>
 void raster_tile(const TileTarget& target, const DrawInputs& draw, const TriangleBatch& batch,
                  TileCounters& counters) {
@@ -125,7 +130,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         TriangleUvs uvs;
         if constexpr (kTexturing != Texturing::none) {
             uvs = TriangleUvs(t, draw.triangles[t.triangle], draw.uvs, batch.clip_weights);
-            if (queue) queue->begin_triangle(t, colors, uvs, batch.clip_weights);
+            if (queue) {
+                queue->begin_triangle(t, colors, uvs, batch.clip_weights);
+                if ((x1 - x0) * (y1 - y0) >= kPrefetchArea) queue->prefetch_area(t, uvs, x0, y0, x1, y1);
+            }
         }
         // Deferred shading's pre-pass: the samples this triangle wins name it by this index.
         std::int32_t owner = -1;
@@ -376,6 +384,20 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
     Shading run_shading = kShading;  // batch_shading of colors, for untextured runs (kColoursByRow)
     std::optional<LookupQueue<BlendMode::replace, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
+    // The texels of an owner's part of the tile, prefetched the first time it becomes current
+    // (runs of two owners can alternate along every row).
+    std::int32_t prefetched[8];
+    int prefetched_count = 0;
+    const auto prefetch_once = [&](std::int32_t owner) {
+        const SetupTriangle& t = *ref.triangle;
+        const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
+        const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
+        if ((x1 - x0) * (y1 - y0) < kPrefetchArea || prefetched_count == 8 ||
+            std::find(prefetched, prefetched + prefetched_count, owner) != prefetched + prefetched_count)
+            return;
+        prefetched[prefetched_count++] = owner;
+        queue->prefetch_area(t, uvs, x0, y0, x1, y1);
+    };
     // Makes `owner` the current triangle if it is one of this draw's (false: another draw's).
     const auto take = [&](std::int32_t owner) {
         if (owner == cached) return true;
@@ -389,7 +411,10 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
         if constexpr (kColoursByRow<kShading, kTexturing>) run_shading = batch_shading(kShading, colors);
         if constexpr (kTexturing != Texturing::none) {
             uvs = TriangleUvs(*ref.triangle, tri, draw.uvs, ref.clip_weights);
-            if (queue) queue->begin_triangle(*ref.triangle, colors, uvs, ref.clip_weights);
+            if (queue) {
+                queue->begin_triangle(*ref.triangle, colors, uvs, ref.clip_weights);
+                prefetch_once(owner);
+            }
         }
         return true;
     };

@@ -345,6 +345,75 @@ bool BatchSampler::covers(const Sampler& s) {
 
 const glm::vec4* BatchSampler::first_use(int k) { return level_texels_[k] = texture_.level(k).texels.data(); }
 
+namespace {
+
+// Texel indices first … last (first ≤ last) along an axis of n texels, as the wrap mode maps
+// them: one range, or two where a repeated range crosses the edge.
+int wrapped_ranges(long first, long last, int n, WrapMode mode, int (&from)[2], int (&to)[2]) {
+    if (mode != WrapMode::repeat) {
+        from[0] = static_cast<int>(std::clamp<long>(first, 0, n - 1));
+        to[0] = static_cast<int>(std::clamp<long>(last, 0, n - 1));
+        return 1;
+    }
+    if (last - first + 1 >= n) {
+        from[0] = 0, to[0] = n - 1;
+        return 1;
+    }
+    const int a = static_cast<int>((first % n + n) % n), b = static_cast<int>((last % n + n) % n);
+    from[0] = a, to[0] = a <= b ? b : n - 1;
+    if (a <= b) return 1;
+    from[1] = 0, to[1] = b;
+    return 2;
+}
+
+}  // namespace
+
+TexelArea texel_area(int w, int h, glm::dvec2 lo, glm::dvec2 hi, WrapMode wrap_u, WrapMode wrap_v) {
+    TexelArea a;
+    constexpr double kLimit = 0x1p20;
+    // (Written so that NaN fails: every comparison with it is false.)
+    if (!(lo.x <= hi.x && lo.y <= hi.y && lo.x >= -kLimit && lo.y >= -kLimit && hi.x <= kLimit && hi.y <= kLimit))
+        return a;
+    // A lookup at x = u·w − ½ reads texels ⌊x⌋ and ⌊x⌋ + 1 (the float path rounds u·w; the spare
+    // texel on each side covers that).
+    a.columns = wrapped_ranges(static_cast<long>(std::floor(lo.x * w - 0.5)) - 1,
+                               static_cast<long>(std::floor(hi.x * w - 0.5)) + 2, w, wrap_u, a.x_from, a.x_to);
+    a.rows = wrapped_ranges(static_cast<long>(std::floor(lo.y * h - 0.5)) - 1,
+                            static_cast<long>(std::floor(hi.y * h - 0.5)) + 2, h, wrap_v, a.y_from, a.y_to);
+    return a;
+}
+
+void BatchSampler::prefetch(glm::dvec2 lo, glm::dvec2 hi, double lambda) {
+    if (!covered_ || !(lambda == lambda)) return;
+    const int levels = texture_.level_count();
+    const bool mipmapped = sampler_.mip_filter == MipFilter::linear;
+    const int finer = !mipmapped || lambda <= 0.0 ? 0 : lambda < levels - 1 ? static_cast<int>(lambda) : levels - 1;
+    const int coarser = mipmapped && finer + 1 < levels && lambda > finer ? finer + 1 : finer;
+    for (int k = finer; k <= coarser; ++k) {
+        const int w = std::max(1, texture_.width() >> k), h = std::max(1, texture_.height() >> k);
+        const TexelArea a = texel_area(w, h, lo, hi, sampler_.wrap_u, sampler_.wrap_v);
+        long rows = 0, columns = 0;
+        for (int i = 0; i < a.rows; ++i) rows += a.y_to[i] - a.y_from[i] + 1;
+        for (int i = 0; i < a.columns; ++i) columns += a.x_to[i] - a.x_from[i] + 1;
+        if (rows * (columns / 4 + 2) > kMaxPrefetchLines) return;
+        // A level no lookup has needed yet is not built for a hint (DESIGN.md §3).
+        const TextureLevel* built = texture_.built_level(k);
+        if (!built) return;
+        // Into the second-level cache: a tile's area can hold more lines than the first-level
+        // cache, where they evicted each other before use (no gain measured from prefetcht0).
+        const glm::vec4* texels = built->texels.data();
+        for (int r = 0; r < a.rows; ++r)
+            for (int y = a.y_from[r]; y <= a.y_to[r]; ++y)
+                for (int c = 0; c < a.columns; ++c) {
+                    const glm::vec4* row = texels + static_cast<std::size_t>(y) * w;
+                    const auto first = reinterpret_cast<std::uintptr_t>(row + a.x_from[c]) & ~std::uintptr_t{63};
+                    const auto end = reinterpret_cast<std::uintptr_t>(row + a.x_to[c] + 1);
+                    for (std::uintptr_t line = first; line < end; line += 64)
+                        __builtin_prefetch(reinterpret_cast<const void*>(line), 0, 2);
+                }
+    }
+}
+
 void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     const int n = batch.count;
     if (n < 0 || n > kLookupBatch)

@@ -36,6 +36,16 @@ inline double batch_sampling_tolerance(int width, int height) {
     return 4e-6 + longest * 0x1p-22;
 }
 
+/// The texels of a w×h level that bilinear lookups at uv in [lo, hi] (component-wise) can read,
+/// with a texel to spare on each side: rows y_from[i] … y_to[i] for i < rows and, in each, columns
+/// x_from[i] … x_to[i] for i < columns (two ranges where a repeated area crosses the texture's
+/// edge). Empty (rows = columns = 0) for a non-finite or inverted box, or one beyond ±2²⁰.
+struct TexelArea {
+    int columns = 0, rows = 0;
+    int x_from[2] = {}, x_to[2] = {}, y_from[2] = {}, y_to[2] = {};
+};
+TexelArea texel_area(int w, int h, glm::dvec2 lo, glm::dvec2 hi, WrapMode wrap_u, WrapMode wrap_v);
+
 /// Samples one texture with one sampler a batch at a time. Lookups the float path handles (see
 /// covers()) go through it. An anisotropic footprint that needs several probes takes the
 /// reference's probe count and line of probes (in double), on the level(s) of the float λ.
@@ -57,6 +67,13 @@ public:
     /// minification, mip filter none or linear, an isotropic or anisotropic footprint, repeat
     /// or clamp on both axes. False: every lane is a sample_texture call.
     static bool covers(const Sampler& sampler);
+
+    /// Asks for the texels that lookups at uv in [lo, hi] read on the level(s) of λ = `lambda`
+    /// to be brought into the second-level cache (a hint: no result depends on it). Nothing for a
+    /// sampler outside covers(), a level not built yet (none is built for it), or an area of
+    /// more than kMaxPrefetchLines cache lines.
+    void prefetch(glm::dvec2 lo, glm::dvec2 hi, double lambda);
+    static constexpr long kMaxPrefetchLines = 2048;  // 128 KiB
 
     /// out[i] for i < batch.count (std::invalid_argument for a count outside 0 … kLookupBatch).
     void sample(const LookupBatch& batch, glm::vec4* out);

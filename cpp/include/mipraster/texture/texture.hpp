@@ -92,6 +92,11 @@ public:
             if (const TextureLevel* built = published_[k].load(std::memory_order_acquire)) return *built;
         return build_level(k);
     }
+    /// Level k if it exists and is built, else null (builds nothing).
+    const TextureLevel* built_level(int k) const {
+        if (k == 0) return base_;
+        return k > 0 && k < levels_ ? published_[k].load(std::memory_order_acquire) : nullptr;
+    }
     /// The summed-area table and the level it was built on.
     const SummedAreaTable& summed_area_table() const;
     int summed_area_table_level() const;
