@@ -303,4 +303,104 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
     EXPECT_GE(passed_pixels, 12000);
 }
 
+// test_pixel_row_avx2 (MSAA rows, a pixel's samples four per vector) against the per-sample
+// arithmetic: coverage from the exact integer edge values, sample_depth(screen_weights(...)) for the
+// test, ties failing. Half the triangles have their vertices on pixel centres and sample 0 is the
+// centre, so edges run through samples (the top-left rule decides them).
+TEST(SampleRows, PixelRowsGiveThePerSampleArithmeticOnRandomRows) {
+    if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2, which test_pixel_row_avx2 needs";
+    const mr::Viewport viewport{96, 80, mr::DepthConvention::reverse_z};
+    std::mt19937_64 rng(62);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const auto bits = [](float x) {
+        std::uint32_t b = 0;
+        std::memcpy(&b, &x, sizeof x);
+        return b;
+    };
+    long rows = 0, on_edges = 0, passed_samples = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        std::array<mr::ScreenVertex, 3> v;
+        for (auto& vertex : v) {
+            const int px = static_cast<int>(rng() % 120) - 12, py = static_cast<int>(rng() % 104) - 12;
+            const int jitter = trial % 2 ? static_cast<int>(rng() % 256) - 128 : 0;
+            vertex = {static_cast<std::int32_t>(px * mr::kSubpixelOne + 128 + jitter),
+                      static_cast<std::int32_t>(py * mr::kSubpixelOne + 128 - jitter), 0.3 + 2.0 * unit(rng),
+                      unit(rng)};
+        }
+        mr::SetupTriangle t;
+        mr::SetupCounters setup_counters;
+        if (!mr::setup_triangle(v, viewport, mr::CullMode::none, t, setup_counters)) continue;
+        const int S = trial % 3 == 0 ? 8 : 4;
+        std::int64_t ox[8], oy[8];
+        double offsets[3][8];
+        for (int s = 0; s < S; ++s) {
+            ox[s] = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
+            oy[s] = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
+            for (int i = 0; i < 3; ++i)
+                offsets[i][s] = static_cast<double>(std::int64_t{t.edge_a[i]} * ox[s] + t.edge_b[i] * oy[s]);
+        }
+        const int y = t.min_y + static_cast<int>(rng() % static_cast<unsigned>(t.max_y - t.min_y + 1));
+        const int x0 = t.min_x - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_x - t.min_x + 3));
+        const int n = 1 + static_cast<int>(rng() % mr::kTileSize);
+        std::int64_t corner[3];
+        const std::int64_t X = std::int64_t{x0} * mr::kSubpixelOne, Y = std::int64_t{y} * mr::kSubpixelOne;
+        for (int i = 0; i < 3; ++i) corner[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+        ASSERT_TRUE(mr::kernels::sample_rows_exact(t, corner, n)) << "trial " << trial;
+        const mr::DepthFunc func = rng() % 2 ? mr::DepthFunc::greater : mr::DepthFunc::less;
+        const bool depth_write = rng() % 2;
+
+        // The per-sample reference.
+        std::vector<float> depth(static_cast<std::size_t>(n * S)), want_depth;
+        std::uint64_t want_covered = 0, want_samples[mr::kTileSize] = {};
+        for (int j = 0; j < n; ++j)
+            for (int s = 0; s < S; ++s) {
+                std::int64_t E[3];
+                for (int i = 0; i < 3; ++i)
+                    E[i] = corner[i] + std::int64_t{t.edge_a[i]} * (mr::kSubpixelOne * j + ox[s]) +
+                           std::int64_t{t.edge_b[i]} * oy[s];
+                const float z = mr::sample_depth(t, mr::screen_weights(t, E[0], E[1], E[2]));
+                const int kind = static_cast<int>(rng() % 4);  // a tie, a random depth, or either end
+                float& stored = depth[static_cast<std::size_t>(j * S + s)];
+                stored = kind == 0 ? z : kind == 1 ? float(unit(rng)) : kind == 2 ? 0.0f : 1.0f;
+                on_edges += E[0] == 0 || E[1] == 0 || E[2] == 0;
+                if ((E[0] | E[1] | E[2]) < 0) continue;
+                ++want_covered;
+                if (!(func == mr::DepthFunc::greater ? z > stored : z < stored)) continue;
+                want_samples[j] |= std::uint64_t{1} << s;
+            }
+        want_depth = depth;
+        for (int j = 0; j < n; ++j)
+            for (int s = 0; s < S; ++s)
+                if (depth_write && (want_samples[j] >> s & 1)) {
+                    std::int64_t E[3];
+                    for (int i = 0; i < 3; ++i)
+                        E[i] = corner[i] + std::int64_t{t.edge_a[i]} * (mr::kSubpixelOne * j + ox[s]) +
+                               std::int64_t{t.edge_b[i]} * oy[s];
+                    const glm::dvec3 l = mr::screen_weights(t, E[0], E[1], E[2]);
+                    want_depth[static_cast<std::size_t>(j * S + s)] = mr::sample_depth(t, l);
+                }
+
+        std::uint64_t samples[mr::kTileSize];
+        const double* const offset_rows[3] = {offsets[0], offsets[1], offsets[2]};
+        const std::uint64_t covered =
+            mr::kernels::test_pixel_row_avx2(t, corner, n, offset_rows, S, func, depth_write, depth.data(), samples);
+        ASSERT_EQ(covered, want_covered) << "trial " << trial;
+        for (int j = 0; j < n; ++j) {
+            ASSERT_EQ(samples[j], want_samples[j]) << "trial " << trial << " pixel " << j;
+            for (int s = 0; s < S; ++s) {
+                const auto k = static_cast<std::size_t>(j * S + s);
+                ASSERT_EQ(bits(depth[k]), bits(want_depth[k]))
+                    << "trial " << trial << " pixel " << j << " sample " << s;
+            }
+        }
+        ++rows;
+        for (int j = 0; j < n; ++j) passed_samples += __builtin_popcountll(want_samples[j]);
+    }
+    std::cout << "rows " << rows << ", samples on an edge " << on_edges << ", passed samples " << passed_samples
+              << "\n";
+    EXPECT_GE(rows, 15000);
+    EXPECT_GE(on_edges, 200);
+    EXPECT_GE(passed_samples, 50000);
+}
+
 }  // namespace

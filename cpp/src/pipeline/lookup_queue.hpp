@@ -75,17 +75,18 @@ public:
         enqueue(target, samples, l.x, l.y, l.z, px, py);
     }
 
-    /// push for one sample of each pixel of a row, in order: bit j of `pixels` is pixel (x0 + j, y),
-    /// its colour slot at row_target + stride·j (floats) and its screen weights l0[j], l1[j], l2[j].
+    /// push for the pixels of a row, in order: bit j of `pixels` is pixel (x0 + j, y), its colour
+    /// slots at row_target + stride·j (floats): one, or (MSAA) samples[j] of them; its screen
+    /// weights l0[j], l1[j], l2[j].
     void push_row(float* row_target, int stride, std::uint32_t pixels, const double* l0, const double* l1,
-                  const double* l2, int x0, int y) {
+                  const double* l2, int x0, int y, const std::uint64_t* samples = nullptr) {
         while (pixels) {
             // Up to a batch at a time with the count in a register (as a member, each pixel's
             // stores into pending_ could change it, so it went through memory pixel by pixel).
             int n = count_;
             for (; pixels && n < kLookupBatch; pixels &= pixels - 1, ++n) {
                 const int j = __builtin_ctz(pixels);
-                put(n, row_target + stride * j, 1, l0[j], l1[j], l2[j], x0 + j, y);
+                put(n, row_target + stride * j, samples ? samples[j] : 1, l0[j], l1[j], l2[j], x0 + j, y);
             }
             count_ = n;
             current_queued_ = true;

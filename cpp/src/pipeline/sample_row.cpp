@@ -1,5 +1,7 @@
 #include "sample_row.hpp"
 
+#include <cstddef>
+
 #include <immintrin.h>
 
 namespace mipraster {
@@ -166,6 +168,54 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         }
     }
     return true;
+}
+
+[[gnu::target("avx2")]] std::uint64_t test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&corner)[3],
+                                                          int n, const double* const (&offsets)[3], int S,
+                                                          DepthFunc func, bool depth_write, float* depth,
+                                                          std::uint64_t* samples) {
+    __m256d first[3], step[3], bias[3];
+    for (int i = 0; i < 3; ++i) {
+        first[i] = _mm256_set1_pd(static_cast<double>(corner[i] + t.bias[i]));
+        step[i] = _mm256_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
+        bias[i] = _mm256_set1_pd(static_cast<double>(t.bias[i]));
+    }
+    const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2), z0 = _mm256_set1_pd(t.z0), dz1 = _mm256_set1_pd(t.dz1),
+                  dz2 = _mm256_set1_pd(t.dz2);
+    const __m128i lane_bit = _mm_setr_epi32(1, 2, 4, 8);
+    const bool greater = func == DepthFunc::greater;
+    std::uint64_t covered_samples = 0;
+    for (int j = 0; j < n; ++j) {
+        // The pixel's corner, e + bias + j·step: exact integers, as are the sums with the offsets.
+        const __m256d x = _mm256_set1_pd(static_cast<double>(j));
+        __m256d pixel[3];
+        for (int i = 0; i < 3; ++i) pixel[i] = _mm256_add_pd(first[i], _mm256_mul_pd(x, step[i]));
+        std::uint64_t passed = 0;
+        for (int g = 0; g < S; g += 4) {
+            __m256d d[3];
+            for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(pixel[i], _mm256_loadu_pd(offsets[i] + g));
+            const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
+                                                               _mm256_cmp_pd(d[1], bias[1], _CMP_GE_OQ)),
+                                                 _mm256_cmp_pd(d[2], bias[2], _CMP_GE_OQ));
+            const auto lanes = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
+            covered_samples += static_cast<std::uint64_t>(__builtin_popcount(lanes));
+            if (!lanes) continue;
+            const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
+            const __m128 z =
+                _mm256_cvtpd_ps(_mm256_add_pd(_mm256_add_pd(z0, _mm256_mul_pd(l1, dz1)), _mm256_mul_pd(l2, dz2)));
+            float* const stored_at = depth + static_cast<std::ptrdiff_t>(j) * S + g;
+            const __m128 stored = _mm_loadu_ps(stored_at);
+            const __m128 asked = _mm_castsi128_ps(
+                _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(lanes)), lane_bit), lane_bit));
+            const __m128 wins = _mm_and_ps(asked, greater ? _mm_cmpgt_ps(z, stored) : _mm_cmplt_ps(z, stored));
+            const auto won = static_cast<std::uint32_t>(_mm_movemask_ps(wins));
+            if (!won) continue;
+            passed |= std::uint64_t{won} << g;
+            if (depth_write) _mm_storeu_ps(stored_at, _mm_blendv_ps(stored, z, wins));
+        }
+        samples[j] = passed;
+    }
+    return covered_samples;
 }
 
 namespace {
