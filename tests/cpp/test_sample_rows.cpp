@@ -290,6 +290,21 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
         };
         check("sse2", mr::kernels::test_sample_row_sse2);
         if (avx2) check("avx2", mr::kernels::test_sample_row_avx2);
+        // sample_row_weights: screen_weights' bits at every pixel of the row, covered or not.
+        const auto check_weights = [&](const char* path, auto row_weights) {
+            double l[3][mr::kTileSize];
+            ASSERT_EQ(row_weights(t, e, n, l[0], l[1], l[2]), exact) << path << " trial " << trial;
+            for (int j = 0; exact && j < n; ++j) {
+                const glm::dvec3 want =
+                    mr::screen_weights(t, e[0] + std::int64_t{t.edge_a[0]} * mr::kSubpixelOne * j,
+                                       e[1] + std::int64_t{t.edge_a[1]} * mr::kSubpixelOne * j,
+                                       e[2] + std::int64_t{t.edge_a[2]} * mr::kSubpixelOne * j);
+                for (int i = 0; i < 3; ++i)
+                    ASSERT_EQ(bits(l[i][j]), bits(want[i])) << path << " weights, trial " << trial << " pixel " << j;
+            }
+        };
+        check_weights("sse2", mr::kernels::sample_row_weights_sse2);
+        if (avx2) check_weights("avx2", mr::kernels::sample_row_weights_avx2);
         ++rows;
         refused += !exact;
         passed_pixels += __builtin_popcount(want_passed);

@@ -133,8 +133,11 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
                   dz2 = _mm256_set1_pd(t.dz2);
     const bool greater = func == DepthFunc::greater;
     out.covered = out.passed = 0;
-    for (int j = 0; j < n; j += 4) {
-        const __m256d x = _mm256_set_pd(double(j + 3), double(j + 2), double(j + 1), double(j));
+    // Pixel indices j … j + 3 (small integers: stepping them by 4 is exact; built from j each
+    // time, the conversions were a chain the loop waited on).
+    const __m256d four = _mm256_set1_pd(4.0);
+    __m256d x = _mm256_set_pd(3.0, 2.0, 1.0, 0.0);
+    for (int j = 0; j < n; j += 4, x = _mm256_add_pd(x, four)) {
         __m256d d[3];
         for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(first[i], _mm256_mul_pd(x, step[i]));  // RowEdges::at
         const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
@@ -228,7 +231,8 @@ bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, 
                                                                    out);
 }
 
-bool sample_row_weights(const SetupTriangle& t, const std::int64_t (&e)[3], int n, double* l0, double* l1, double* l2) {
+bool sample_row_weights_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], int n, double* l0, double* l1,
+                             double* l2) {
     if (!exact_row(t, e, n)) return false;
     const RowEdges edges(t, e);
     double* const out[3] = {l0, l1, l2};
@@ -236,6 +240,25 @@ bool sample_row_weights(const SetupTriangle& t, const std::int64_t (&e)[3], int 
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < n; j += 2) _mm_storeu_pd(out[i] + j, _mm_mul_pd(edges.at(i, j), inv_area2));
     return true;
+}
+
+[[gnu::target("avx2")]] bool sample_row_weights_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], int n,
+                                                     double* l0, double* l1, double* l2) {
+    if (!exact_row(t, e, n)) return false;
+    double* const out[3] = {l0, l1, l2};
+    const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2);
+    for (int i = 0; i < 3; ++i) {
+        const __m256d first = _mm256_set1_pd(static_cast<double>(e[i] + t.bias[i]));
+        const __m256d step = _mm256_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
+        __m256d x = _mm256_set_pd(3.0, 2.0, 1.0, 0.0);  // (stepped as in test_sample_row_avx2)
+        for (int j = 0; j < n; j += 4, x = _mm256_add_pd(x, _mm256_set1_pd(4.0)))
+            _mm256_storeu_pd(out[i] + j, _mm256_mul_pd(_mm256_add_pd(first, _mm256_mul_pd(x, step)), inv_area2));
+    }
+    return true;
+}
+
+bool sample_row_weights(const SetupTriangle& t, const std::int64_t (&e)[3], int n, double* l0, double* l1, double* l2) {
+    return (kHasAvx2 ? sample_row_weights_avx2 : sample_row_weights_sse2)(t, e, n, l0, l1, l2);
 }
 
 }  // namespace kernels

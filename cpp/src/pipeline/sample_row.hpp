@@ -54,9 +54,14 @@ std::uint64_t test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&c
                                   float* depth, std::uint64_t* samples);
 
 /// The screen weights of pixels j < n of a row whose first pixel's sample has edge values e (bias
-/// not added), into l_i[j] (room for n rounded up to even): screen_weights' bits. False, touching
-/// nothing, where test_sample_row would be.
+/// not added), into l_i[j] (room for n rounded up to a multiple of 4): screen_weights' bits. False,
+/// touching nothing, where test_sample_row would be. Two doubles per vector (SSE2) or four (AVX2,
+/// where the CPU has it): the same bits; sample_row_weights takes the widest.
 bool sample_row_weights(const SetupTriangle& t, const std::int64_t (&e)[3], int n, double* l0, double* l1, double* l2);
+bool sample_row_weights_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], int n, double* l0, double* l1,
+                             double* l2);
+bool sample_row_weights_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], int n, double* l0, double* l1,
+                             double* l2);
 
 /// Set bits of a mask (baseline x86-64 has no popcnt instruction; GCC would call libgcc).
 [[gnu::always_inline]] inline int count_bits(std::uint32_t m) {
