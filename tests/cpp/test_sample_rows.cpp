@@ -184,31 +184,39 @@ TEST(SampleRows, TrianglesWithEdgeValuesPast2To52GiveThePerSampleBits) {
 // here (exact integer edge values, screen_weights, sample_depth, a strict test): both vector
 // widths give its coverage, outcomes, weights and stored depths bit for bit, touch no other
 // sample, and refuse the rows whose edge values reach 2^52. Without AVX2 only the SSE2 path runs.
+// A random triangle about a 96×80 viewport, set up (false: setup refused it). Every other trial
+// has its vertices on pixel centres, so that its edges run through samples (the top-left rule
+// decides those).
+bool random_row_triangle(std::mt19937_64& rng, int trial, mr::SetupTriangle& t) {
+    const mr::Viewport viewport{96, 80, mr::DepthConvention::reverse_z};
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::array<mr::ScreenVertex, 3> v;
+    for (auto& vertex : v) {
+        const int px = static_cast<int>(rng() % 120) - 12, py = static_cast<int>(rng() % 104) - 12;
+        const int jitter = trial % 2 ? static_cast<int>(rng() % 256) - 128 : 0;
+        vertex = {static_cast<std::int32_t>(px * mr::kSubpixelOne + 128 + jitter),
+                  static_cast<std::int32_t>(py * mr::kSubpixelOne + 128 - jitter), 0.3 + 2.0 * unit(rng), unit(rng)};
+    }
+    mr::SetupCounters counters;
+    return mr::setup_triangle(v, viewport, mr::CullMode::none, t, counters);
+}
+
+// The bits of a float or double.
+template <typename T>
+std::uint64_t bits(T x) {
+    std::uint64_t b = 0;
+    std::memcpy(&b, &x, sizeof x);
+    return b;
+}
+
 TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
     const bool avx2 = __builtin_cpu_supports("avx2");
-    const mr::Viewport viewport{96, 80, mr::DepthConvention::reverse_z};
     std::mt19937_64 rng(61);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
-    const auto bits = [](auto x) {
-        std::uint64_t b = 0;
-        std::memcpy(&b, &x, sizeof x);
-        return b;
-    };
     long rows = 0, refused = 0, passed_pixels = 0, near_bound = 0;
     for (int trial = 0; trial < 20000; ++trial) {
-        // Every other triangle has its vertices on pixel centres, so that its edges run through
-        // samples (the top-left rule decides those).
-        std::array<mr::ScreenVertex, 3> v;
-        for (auto& vertex : v) {
-            const int px = static_cast<int>(rng() % 120) - 12, py = static_cast<int>(rng() % 104) - 12;
-            const int jitter = trial % 2 ? static_cast<int>(rng() % 256) - 128 : 0;
-            vertex = {static_cast<std::int32_t>(px * mr::kSubpixelOne + 128 + jitter),
-                      static_cast<std::int32_t>(py * mr::kSubpixelOne + 128 - jitter),
-                      0.3 + 2.0 * unit(rng), unit(rng)};
-        }
         mr::SetupTriangle t;
-        mr::SetupCounters counters;
-        if (!mr::setup_triangle(v, viewport, mr::CullMode::none, t, counters)) continue;
+        if (!random_row_triangle(rng, trial, t)) continue;
         const int y = t.min_y + static_cast<int>(rng() % static_cast<unsigned>(t.max_y - t.min_y + 1));
         const int x0 = t.min_x - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_x - t.min_x + 3));
         const int n = 1 + static_cast<int>(rng() % mr::kTileSize);
@@ -320,31 +328,15 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
 
 // test_pixel_row_avx2 (MSAA rows, a pixel's samples four per vector) against the per-sample
 // arithmetic: coverage from the exact integer edge values, sample_depth(screen_weights(...)) for the
-// test, ties failing. Half the triangles have their vertices on pixel centres and sample 0 is the
-// centre, so edges run through samples (the top-left rule decides them).
+// test, ties failing. Sample 0 is the pixel centre, through which half the triangles' edges run.
 TEST(SampleRows, PixelRowsGiveThePerSampleArithmeticOnRandomRows) {
     if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2, which test_pixel_row_avx2 needs";
-    const mr::Viewport viewport{96, 80, mr::DepthConvention::reverse_z};
     std::mt19937_64 rng(62);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
-    const auto bits = [](float x) {
-        std::uint32_t b = 0;
-        std::memcpy(&b, &x, sizeof x);
-        return b;
-    };
     long rows = 0, on_edges = 0, passed_samples = 0;
     for (int trial = 0; trial < 20000; ++trial) {
-        std::array<mr::ScreenVertex, 3> v;
-        for (auto& vertex : v) {
-            const int px = static_cast<int>(rng() % 120) - 12, py = static_cast<int>(rng() % 104) - 12;
-            const int jitter = trial % 2 ? static_cast<int>(rng() % 256) - 128 : 0;
-            vertex = {static_cast<std::int32_t>(px * mr::kSubpixelOne + 128 + jitter),
-                      static_cast<std::int32_t>(py * mr::kSubpixelOne + 128 - jitter), 0.3 + 2.0 * unit(rng),
-                      unit(rng)};
-        }
         mr::SetupTriangle t;
-        mr::SetupCounters setup_counters;
-        if (!mr::setup_triangle(v, viewport, mr::CullMode::none, t, setup_counters)) continue;
+        if (!random_row_triangle(rng, trial, t)) continue;
         const int S = trial % 3 == 0 ? 8 : 4;
         std::int64_t ox[8], oy[8];
         double offsets[3][8];

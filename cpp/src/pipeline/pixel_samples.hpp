@@ -28,6 +28,35 @@ inline bool below_2_to_51(std::int64_t x) {
     return x > -kBound && x < kBound;
 }
 
+/// A triangle's depth plane, z0 + l1·dz1 + l2·dz2, in four lanes (made once per triangle: inside
+/// a loop that stores depths, the triangle's fields would be read again every time).
+struct DepthPlane4 {
+    __m256d z0, dz1, dz2;
+};
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline DepthPlane4 depth_plane4(const SetupTriangle& t) {
+    return {_mm256_set1_pd(t.z0), _mm256_set1_pd(t.dz1), _mm256_set1_pd(t.dz2)};
+}
+
+/// The depth test of four samples at screen weights l1, l2 (edges 1 and 2) against depth[0 … 3],
+/// at the lanes of `lanes` (bit k: sample k): z = z0 + l1·dz1 + l2·dz2 rounded to float, as
+/// sample_depth computes it; the passing depths are stored when depth_write. Returns the lanes
+/// that passed.
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline std::uint32_t test_four_depths(
+    const DepthPlane4& plane, __m256d l1, __m256d l2, std::uint32_t lanes, DepthFunc func, bool depth_write,
+    float* depth) {
+    const __m128i lane_bit = _mm_setr_epi32(1, 2, 4, 8);
+    const __m128 z = _mm256_cvtpd_ps(
+        _mm256_add_pd(_mm256_add_pd(plane.z0, _mm256_mul_pd(l1, plane.dz1)), _mm256_mul_pd(l2, plane.dz2)));
+    const __m128 stored = _mm_loadu_ps(depth);
+    const __m128 asked = _mm_castsi128_ps(
+        _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(lanes)), lane_bit), lane_bit));
+    const __m128 wins =
+        _mm_and_ps(asked, func == DepthFunc::greater ? _mm_cmpgt_ps(z, stored) : _mm_cmplt_ps(z, stored));
+    const auto won = static_cast<std::uint32_t>(_mm_movemask_ps(wins));
+    if (won && depth_write) _mm_storeu_ps(depth, _mm_blendv_ps(stored, z, wins));
+    return won;
+}
+
 /// Tests the depth of samples `covered` (bit s: sample s) against depth[s] (less or greater) and
 /// stores the passing depths when depth_write; the passing samples go to `passed`. Returns
 /// false, touching nothing, when an edge value reaches 2^51 in magnitude (its sums in double
@@ -45,25 +74,15 @@ inline bool below_2_to_51(std::int64_t x) {
     // screen_weights converts e + offset + bias to double; here e + bias and the offset are
     // converted apart and added: the same integer exactly, below 2^52.
     const __m256d corner1 = _mm256_set1_pd(static_cast<double>(e1)), corner2 = _mm256_set1_pd(static_cast<double>(e2));
-    const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2), z0 = _mm256_set1_pd(t.z0), dz1 = _mm256_set1_pd(t.dz1),
-                  dz2 = _mm256_set1_pd(t.dz2);
-    const __m128i lane_bit = _mm_setr_epi32(1, 2, 4, 8);
-    const bool greater = func == DepthFunc::greater;
+    const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2);
+    const DepthPlane4 plane = depth_plane4(t);
     passed = 0;
     for (int g = 0; g < p.count; g += 4) {
         const auto lanes = static_cast<std::uint32_t>((covered >> g) & 15u);
         if (!lanes) continue;
         const __m256d l1 = _mm256_mul_pd(_mm256_add_pd(corner1, _mm256_loadu_pd(p.offset1 + g)), inv_area2);
         const __m256d l2 = _mm256_mul_pd(_mm256_add_pd(corner2, _mm256_loadu_pd(p.offset2 + g)), inv_area2);
-        const __m128 z = _mm256_cvtpd_ps(_mm256_add_pd(_mm256_add_pd(z0, _mm256_mul_pd(l1, dz1)), _mm256_mul_pd(l2, dz2)));
-        const __m128 stored = _mm_loadu_ps(depth + g);
-        const __m128 asked = _mm_castsi128_ps(
-            _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(lanes)), lane_bit), lane_bit));
-        const __m128 wins = _mm_and_ps(asked, greater ? _mm_cmpgt_ps(z, stored) : _mm_cmplt_ps(z, stored));
-        const auto won = static_cast<std::uint32_t>(_mm_movemask_ps(wins));
-        if (!won) continue;
-        passed |= std::uint64_t{won} << g;
-        if (depth_write) _mm_storeu_ps(depth + g, _mm_blendv_ps(stored, z, wins));
+        passed |= std::uint64_t{test_four_depths(plane, l1, l2, lanes, func, depth_write, depth + g)} << g;
     }
     return true;
 }

@@ -242,7 +242,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                                             corner[1] + (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * half,
                                             corner[2] + (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * half};
             double l0[kTileSize], l1[kTileSize], l2[kTileSize];
-            sample_row_weights(t, centre, n, l0, l1, l2);  // (exact: a centre is a sample position)
+            sample_row_weights(t, centre, n, l0, l1, l2);  // (exact: the centres lie within the row's pixels)
             for (std::uint32_t m = pixels; m; m &= m - 1) {
                 const int j = __builtin_ctz(m);
                 if (((centre[0] + j * step0) | (centre[1] + j * step1) | (centre[2] + j * step2)) >= 0) continue;

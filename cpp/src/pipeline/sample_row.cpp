@@ -4,6 +4,8 @@
 
 #include <immintrin.h>
 
+#include "pixel_samples.hpp"
+
 namespace mipraster {
 namespace kernels {
 
@@ -183,10 +185,8 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         step[i] = _mm256_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
         bias[i] = _mm256_set1_pd(static_cast<double>(t.bias[i]));
     }
-    const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2), z0 = _mm256_set1_pd(t.z0), dz1 = _mm256_set1_pd(t.dz1),
-                  dz2 = _mm256_set1_pd(t.dz2);
-    const __m128i lane_bit = _mm_setr_epi32(1, 2, 4, 8);
-    const bool greater = func == DepthFunc::greater;
+    const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2);
+    const DepthPlane4 plane = depth_plane4(t);
     std::uint64_t covered_samples = 0;
     for (int j = 0; j < n; ++j) {
         // The pixel's corner, e + bias + j·step: exact integers, as are the sums with the offsets.
@@ -204,17 +204,8 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
             covered_samples += static_cast<std::uint64_t>(__builtin_popcount(lanes));
             if (!lanes) continue;
             const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
-            const __m128 z =
-                _mm256_cvtpd_ps(_mm256_add_pd(_mm256_add_pd(z0, _mm256_mul_pd(l1, dz1)), _mm256_mul_pd(l2, dz2)));
-            float* const stored_at = depth + static_cast<std::ptrdiff_t>(j) * S + g;
-            const __m128 stored = _mm_loadu_ps(stored_at);
-            const __m128 asked = _mm_castsi128_ps(
-                _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(lanes)), lane_bit), lane_bit));
-            const __m128 wins = _mm_and_ps(asked, greater ? _mm_cmpgt_ps(z, stored) : _mm_cmplt_ps(z, stored));
-            const auto won = static_cast<std::uint32_t>(_mm_movemask_ps(wins));
-            if (!won) continue;
-            passed |= std::uint64_t{won} << g;
-            if (depth_write) _mm_storeu_ps(stored_at, _mm_blendv_ps(stored, z, wins));
+            float* const stored = depth + static_cast<std::ptrdiff_t>(j) * S + g;
+            passed |= std::uint64_t{test_four_depths(plane, l1, l2, lanes, func, depth_write, stored)} << g;
         }
         samples[j] = passed;
     }
