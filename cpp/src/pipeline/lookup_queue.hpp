@@ -5,6 +5,7 @@
 // call, then blend in the order they were queued, which is the order the forward path blends
 // them in. Blends read the target when they run, so a sample queued twice (by two triangles)
 // still sees the first result under the second.
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 
@@ -39,11 +40,19 @@ public:
                                 batch_shading(kShading, colors)};
     }
 
-    /// Asks for the texels triangle t reads in pixels [x0, x1) × [y0, y1) to be brought into the
-    /// cache before its samples there are queued (see BatchSampler::prefetch). The area is
-    /// bounded by the uvs at the four corner pixels (the planes extended beyond the triangle, as
-    /// for quad derivatives) and by its vertices' uvs; its λ is the finest of the corners'.
-    void prefetch_area(const SetupTriangle& t, const TriangleUvs& uvs, int x0, int y0, int x1, int y1) {
+    /// Asks for the texels triangle t reads in the tile [tile_x0, tile_x1) × [tile_y0, tile_y1) to
+    /// be brought into the cache before its samples there are queued (see BatchSampler::prefetch).
+    /// The area is bounded by the uvs at the four corner pixels of its bounds in the tile (the
+    /// planes extended beyond the triangle, as for quad derivatives) and by its vertices' uvs; its
+    /// λ is the finest of the corners'. False, asking for nothing, where its bounds hold fewer than
+    /// kPrefetchArea pixels of the tile: a smaller part reads few texels, and the prefetch would
+    /// cost more than the misses it saves.
+    static constexpr int kPrefetchArea = 256;
+    bool prefetch_area(const SetupTriangle& t, const TriangleUvs& uvs, int tile_x0, int tile_y0, int tile_x1,
+                       int tile_y1) {
+        const int x0 = std::max(t.min_x, tile_x0), x1 = std::min(t.max_x + 1, tile_x1);
+        const int y0 = std::max(t.min_y, tile_y0), y1 = std::min(t.max_y + 1, tile_y1);
+        if (x1 - x0 < 1 || y1 - y0 < 1 || (x1 - x0) * (y1 - y0) < kPrefetchArea) return false;
         glm::dvec2 lo = glm::min(glm::min(uvs.v[0], uvs.v[1]), uvs.v[2]);
         glm::dvec2 hi = glm::max(glm::max(uvs.v[0], uvs.v[1]), uvs.v[2]);
         glm::dvec2 corners_lo(std::numeric_limits<double>::infinity()), corners_hi = -corners_lo;
@@ -58,7 +67,7 @@ public:
                 // Beyond the triangle's horizon (1/w ≤ 0 there) the extended planes mean nothing.
                 if (draw_.uv_interpolation == Interpolation::perspective &&
                     !(l.x * t.inv_w[0] + l.y * t.inv_w[1] + l.z * t.inv_w[2] > 0.0))
-                    return;
+                    return true;
                 const UvSample s = texture_lookup<kTexturing>(draw_, t, uvs, l, px, py);
                 corners_lo = glm::min(corners_lo, s.uv), corners_hi = glm::max(corners_hi, s.uv);
                 double corner_lambda = 0.0;  // (a sampler without derivatives reads level 0)
@@ -67,6 +76,7 @@ public:
                 lambda = std::min(lambda, corner_lambda);
             }
         sampler_.prefetch(glm::max(lo, corners_lo), glm::min(hi, corners_hi), lambda);
+        return true;
     }
 
     /// Queues the shade of samples `samples` (a bit mask) at 4-float colour slots of `target`:

@@ -81,12 +81,6 @@ inline bool queues_lookups(const DrawInputs& draw) {
     return kTexturing != Texturing::none && draw.batched_lookups && draw.debug_view == DebugView::none;
 }
 
-// A textured triangle whose bounds hold this many pixels of a tile or more has the texels it reads
-// there prefetched (LookupQueue::prefetch_area) as it starts; a smaller one reads few texels, and
-// the prefetch would cost more than the misses it saves. So would one behind what is drawn in
-// some of its blocks (overdraw MSAA 4x: 8 % of the frame went to such prefetches).
-inline constexpr int kPrefetchArea = 256;
-
 template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode, Texturing kTexturing>
 void raster_tile(const TileTarget& target, const DrawInputs& draw, const TriangleBatch& batch,
                  TileCounters& counters) {
@@ -133,7 +127,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             uvs = TriangleUvs(t, draw.triangles[t.triangle], draw.uvs, batch.clip_weights);
             if (queue) {
                 queue->begin_triangle(t, colors, uvs, batch.clip_weights);
-                if ((x1 - x0) * (y1 - y0) >= kPrefetchArea && !cls.hidden) queue->prefetch_area(t, uvs, x0, y0, x1, y1);
+                // Its texels in this tile, asked for as it starts; not for a triangle behind what is
+                // drawn in some of its blocks, which reads few (overdraw MSAA 4x: 8 % of the frame
+                // went to such prefetches).
+                if (!cls.hidden) queue->prefetch_area(t, uvs, target.x0, target.y0, target.x1, target.y1);
             }
         }
         // Deferred shading's pre-pass: the samples this triangle wins name it by this index.
@@ -439,14 +436,11 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
     std::int32_t prefetched[8];
     int prefetched_count = 0;
     const auto prefetch_once = [&](std::int32_t owner) {
-        const SetupTriangle& t = *ref.triangle;
-        const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
-        const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
-        if ((x1 - x0) * (y1 - y0) < kPrefetchArea || prefetched_count == 8 ||
+        if (prefetched_count == 8 ||
             std::find(prefetched, prefetched + prefetched_count, owner) != prefetched + prefetched_count)
             return;
-        prefetched[prefetched_count++] = owner;
-        queue->prefetch_area(t, uvs, x0, y0, x1, y1);
+        if (queue->prefetch_area(*ref.triangle, uvs, target.x0, target.y0, target.x1, target.y1))
+            prefetched[prefetched_count++] = owner;
     };
     // Makes `owner` the current triangle if it is one of this draw's (false: another draw's).
     const auto take = [&](std::int32_t owner) {

@@ -390,15 +390,15 @@ void BatchSampler::prefetch(glm::dvec2 lo, glm::dvec2 hi, double lambda) {
     const int finer = !mipmapped || lambda <= 0.0 ? 0 : lambda < levels - 1 ? static_cast<int>(lambda) : levels - 1;
     const int coarser = mipmapped && finer + 1 < levels && lambda > finer ? finer + 1 : finer;
     for (int k = finer; k <= coarser; ++k) {
-        const int w = std::max(1, texture_.width() >> k), h = std::max(1, texture_.height() >> k);
-        const TexelArea a = texel_area(w, h, lo, hi, sampler_.wrap_u, sampler_.wrap_v);
+        // A level no lookup has needed yet is not built for a hint (DESIGN.md §3).
+        const TextureLevel* built = texture_.built_level(k);
+        if (!built) return;
+        const int w = built->width;
+        const TexelArea a = texel_area(w, built->height, lo, hi, sampler_.wrap_u, sampler_.wrap_v);
         long rows = 0, columns = 0;
         for (int i = 0; i < a.rows; ++i) rows += a.y_to[i] - a.y_from[i] + 1;
         for (int i = 0; i < a.columns; ++i) columns += a.x_to[i] - a.x_from[i] + 1;
         if (rows * (columns / 4 + 2) > kMaxPrefetchLines) return;
-        // A level no lookup has needed yet is not built for a hint (DESIGN.md §3).
-        const TextureLevel* built = texture_.built_level(k);
-        if (!built) return;
         // Into the second-level cache: a tile's area can hold more lines than the first-level
         // cache, where they evicted each other before use (no gain measured from prefetcht0).
         const glm::vec4* texels = built->texels.data();
