@@ -86,32 +86,54 @@ double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1)
     return box_share(t, bx0, by0, bx1, by1);
 }
 
-void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas) {
-    // Pass 1 counts the entries of each tile (and adds up the area each triangle covers of it),
-    // pass 2 places triangle indices in order.
+static_assert((kMaxDimension + kTileSize - 1) / kTileSize <= 65536, "tile coordinates must fit 16 bits");
+
+ChunkBinner::ChunkBinner(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas)
+    : chunk_(chunk), grid_(grid), overlap_areas_(overlap_areas) {
     chunk.tile_start.assign(static_cast<std::size_t>(grid.count()) + 1, 0);
     chunk.tile_area.assign(overlap_areas ? static_cast<std::size_t>(grid.count()) : 0, 0.0);
-    auto for_each_tile = [&](const SetupTriangle& t, auto&& visit) {
-        for (int ty = t.min_y / kTileSize; ty <= t.max_y / kTileSize; ++ty)
-            for (int tx = t.min_x / kTileSize; tx <= t.max_x / kTileSize; ++tx) visit(ty * grid.tiles_x + tx, tx, ty);
-    };
-    for (const SetupTriangle& t : chunk.triangles)
-        for_each_tile(t, [&](int tile, int tx, int ty) {
-            ++chunk.tile_start[static_cast<std::size_t>(tile) + 1];
-            if (!overlap_areas) return;
-            const int x0 = tx * kTileSize, y0 = ty * kTileSize;
-            const int x1 = std::min(x0 + kTileSize, grid.width), y1 = std::min(y0 + kTileSize, grid.height);
-            // (Most small triangles lie inside one tile: tile_overlap_area's first case, inline.)
-            chunk.tile_area[static_cast<std::size_t>(tile)] +=
-                box_inside(t, x0, y0, x1, y1) ? box_share(t, t.min_x, t.min_y, t.max_x + 1, t.max_y + 1)
+    reserve_on_huge_pages(spans_, chunk.triangles.capacity());
+}
+
+void ChunkBinner::add() {
+    for (std::size_t i = spans_.size(); i < chunk_.triangles.size(); ++i) {
+        const SetupTriangle& t = chunk_.triangles[i];
+        const auto tile_of = [](int pixel) { return static_cast<std::uint16_t>(pixel / kTileSize); };
+        const TileSpan span{tile_of(t.min_x), tile_of(t.min_y), tile_of(t.max_x), tile_of(t.max_y)};
+        spans_.push_back(span);
+        for (int ty = span.y0; ty <= span.y1; ++ty)
+            for (int tx = span.x0; tx <= span.x1; ++tx) {
+                const std::size_t tile = static_cast<std::size_t>(ty) * grid_.tiles_x + tx;
+                ++chunk_.tile_start[tile + 1];
+                if (!overlap_areas_) continue;
+                const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+                const int x1 = std::min(x0 + kTileSize, grid_.width), y1 = std::min(y0 + kTileSize, grid_.height);
+                // (Most small triangles lie inside one tile: tile_overlap_area's first case, inline.)
+                chunk_.tile_area[tile] += box_inside(t, x0, y0, x1, y1)
+                                              ? box_share(t, t.min_x, t.min_y, t.max_x + 1, t.max_y + 1)
                                               : tile_overlap_area(t, x0, y0, x1, y1);
-        });
-    for (std::size_t i = 1; i < chunk.tile_start.size(); ++i) chunk.tile_start[i] += chunk.tile_start[i - 1];
-    reserve_on_huge_pages(chunk.tile_triangles, chunk.tile_start.back());
-    chunk.tile_triangles.resize(chunk.tile_start.back());
-    std::vector<std::uint32_t> cursor(chunk.tile_start.begin(), chunk.tile_start.end() - 1);
-    for (std::uint32_t i = 0; i < chunk.triangles.size(); ++i)
-        for_each_tile(chunk.triangles[i], [&](int tile, int, int) { chunk.tile_triangles[cursor[tile]++] = i; });
+            }
+    }
+}
+
+void ChunkBinner::finish() {
+    std::vector<std::uint32_t>& start = chunk_.tile_start;
+    for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    reserve_on_huge_pages(chunk_.tile_triangles, start.back());
+    chunk_.tile_triangles.resize(start.back());
+    std::vector<std::uint32_t> cursor(start.begin(), start.end() - 1);
+    for (std::uint32_t i = 0; i < spans_.size(); ++i) {
+        const TileSpan span = spans_[i];
+        for (int ty = span.y0; ty <= span.y1; ++ty)
+            for (int tx = span.x0; tx <= span.x1; ++tx)
+                chunk_.tile_triangles[cursor[static_cast<std::size_t>(ty) * grid_.tiles_x + tx]++] = i;
+    }
+}
+
+void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas) {
+    ChunkBinner binner(chunk, grid, overlap_areas);
+    binner.add();
+    binner.finish();
 }
 
 }  // namespace mipraster

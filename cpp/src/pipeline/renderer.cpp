@@ -78,6 +78,8 @@ constexpr std::size_t kVertexRun = 512;
 // Triangles per chunk: enough chunks for load balance, few enough that per-chunk tile tables stay
 // small. The split never changes the output (see BinnedChunk).
 constexpr std::size_t kMinChunkTriangles = 256;
+// Triangles set up before binning counts them (their set-up data, 32 KiB, stays in the L1 cache).
+constexpr std::uint32_t kBinRun = 256;
 
 void validate_draws(const std::vector<Draw>& draws) {
     for (std::size_t i = 0; i < draws.size(); ++i) {
@@ -140,63 +142,68 @@ void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices,
                  const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid, bool overlap_areas,
                  BinnedChunk& chunk, SetupCounters& counters, std::uint64_t& clipped) {
     reserve_on_huge_pages(chunk.triangles, range.last - range.first);
+    ChunkBinner binner(chunk, grid, overlap_areas);
     SetupTriangle st;
     ClipPolygon polygon;
-    for (std::uint32_t t = range.first; t < range.last; ++t) {
-        const glm::uvec3 tri = (*vertices.triangles)[t];
-        const std::array<std::uint8_t, 3> codes = {vertices.outcodes[tri[0]], vertices.outcodes[tri[1]],
-                                                   vertices.outcodes[tri[2]]};
-        if ((codes[0] | codes[1] | codes[2]) & kNonFinite) {
-            ++counters.dropped_nonfinite;
-            continue;
-        }
-        st.triangle = t;
-        st.draw = range.draw;
-        if ((codes[0] | codes[1] | codes[2]) == 0) {  // inside: its vertices are projected already
-            st.clip_index = -1;
-            if (setup_triangle({vertices.screen[tri[0]], vertices.screen[tri[1]], vertices.screen[tri[2]]}, viewport,
-                               vertices.cull, st, counters))
-                chunk.triangles.push_back(st);
-            continue;
-        }
-        const std::array<glm::dvec4, 3> p = {vertices.positions[tri[0]], vertices.positions[tri[1]],
-                                             vertices.positions[tri[2]]};
-        switch (clip_triangle(p, codes, volume, polygon)) {
-            case ClipOutcome::inside:  // (only for outcodes that OR to 0: set up above)
-            case ClipOutcome::outside: ++counters.culled_outside; break;
-            case ClipOutcome::clipped: {
-                ++clipped;
-                if (projects_to_a_line(p)) {  // zero area: clipping would round area into it
-                    ++counters.culled_degenerate;
+    for (std::uint32_t run = range.first; run < range.last; run += kBinRun) {
+        for (std::uint32_t t = run; t < std::min(range.last, run + kBinRun); ++t) {
+            const glm::uvec3 tri = (*vertices.triangles)[t];
+            const std::array<std::uint8_t, 3> codes = {vertices.outcodes[tri[0]], vertices.outcodes[tri[1]],
+                                                       vertices.outcodes[tri[2]]};
+            if ((codes[0] | codes[1] | codes[2]) & kNonFinite) {
+                ++counters.dropped_nonfinite;
+                continue;
+            }
+            st.triangle = t;
+            st.draw = range.draw;
+            if ((codes[0] | codes[1] | codes[2]) == 0) {  // inside: its vertices are projected already
+                st.clip_index = -1;
+                const std::array<ScreenVertex, 3> v = {vertices.screen[tri[0]], vertices.screen[tri[1]],
+                                                       vertices.screen[tri[2]]};
+                if (setup_triangle(v, viewport, vertices.cull, st, counters))
+                    chunk.triangles.push_back(st);
+                continue;
+            }
+            const std::array<glm::dvec4, 3> p = {vertices.positions[tri[0]], vertices.positions[tri[1]],
+                                                 vertices.positions[tri[2]]};
+            switch (clip_triangle(p, codes, volume, polygon)) {
+                case ClipOutcome::inside:  // (only for outcodes that OR to 0: set up above)
+                case ClipOutcome::outside: ++counters.culled_outside; break;
+                case ClipOutcome::clipped: {
+                    ++clipped;
+                    if (projects_to_a_line(p)) {  // zero area: clipping would round area into it
+                        ++counters.culled_degenerate;
+                        break;
+                    }
+                    // Fan-triangulate the clipped polygon; each piece keeps its original-triangle weights.
+                    SetupCounters pieces;
+                    bool any = false;
+                    for (int i = 1; i + 1 < polygon.count; ++i) {
+                        const ClipVertex* v[3] = {&polygon.vertices[0], &polygon.vertices[i], &polygon.vertices[i + 1]};
+                        st.clip_index = static_cast<std::int32_t>(chunk.clip_weights.size());
+                        const std::array<glm::dvec4, 3> piece = {v[0]->position, v[1]->position, v[2]->position};
+                        if (setup_triangle(piece, viewport, vertices.cull, st, pieces)) {
+                            any = true;
+                            chunk.triangles.push_back(st);
+                            chunk.clip_weights.push_back(
+                                {glm::vec3(v[0]->weights), glm::vec3(v[1]->weights), glm::vec3(v[2]->weights)});
+                        }
+                    }
+                    // The counters count submitted triangles: a clipped one that drew nothing counts
+                    // once, under the first reason that applies to its pieces.
+                    if (!any) {
+                        if (pieces.culled_backface) ++counters.culled_backface;
+                        else if (pieces.dropped_nonfinite) ++counters.dropped_nonfinite;
+                        else if (pieces.culled_outside) ++counters.culled_outside;
+                        else ++counters.culled_degenerate;
+                    }
                     break;
                 }
-                // Fan-triangulate the clipped polygon; each piece keeps its original-triangle weights.
-                SetupCounters pieces;
-                bool any = false;
-                for (int i = 1; i + 1 < polygon.count; ++i) {
-                    const ClipVertex* v[3] = {&polygon.vertices[0], &polygon.vertices[i], &polygon.vertices[i + 1]};
-                    st.clip_index = static_cast<std::int32_t>(chunk.clip_weights.size());
-                    if (setup_triangle({v[0]->position, v[1]->position, v[2]->position}, viewport, vertices.cull, st,
-                                       pieces)) {
-                        any = true;
-                        chunk.triangles.push_back(st);
-                        chunk.clip_weights.push_back(
-                            {glm::vec3(v[0]->weights), glm::vec3(v[1]->weights), glm::vec3(v[2]->weights)});
-                    }
-                }
-                // The counters count submitted triangles: a clipped one that drew nothing counts
-                // once, under the first reason that applies to its pieces.
-                if (!any) {
-                    if (pieces.culled_backface) ++counters.culled_backface;
-                    else if (pieces.dropped_nonfinite) ++counters.dropped_nonfinite;
-                    else if (pieces.culled_outside) ++counters.culled_outside;
-                    else ++counters.culled_degenerate;
-                }
-                break;
             }
         }
+        binner.add();  // (the run's set-up triangles are still in cache)
     }
-    bin_triangles(chunk, grid, overlap_areas);
+    binner.finish();
 }
 
 // Stage 2: clip, set up and bin every draw's triangles, in parallel over chunks of consecutive
