@@ -143,8 +143,10 @@ template <int W>
 }
 
 // Texel indices and fractions along one axis at level sizes n (float and int, per lane), for a
-// bilinear quad at x = coordinate·n − ½ (the product is exact for a power-of-two size).
-template <int W>
+// bilinear quad at x = coordinate·n − ½ (the product is exact for a power-of-two size). A
+// repeated coordinate in [0, 1] puts ⌊x⌋ in [−1, n − 1]: on power-of-two sizes (kPowerOfTwo)
+// the wrap is a mask.
+template <int W, bool kPowerOfTwo>
 [[gnu::always_inline]] inline void axis(typename Lanes<W>::Floats reduced, typename Lanes<W>::Floats n,
                                         typename Lanes<W>::Ints n_int, WrapMode mode, typename Lanes<W>::Ints& lo,
                                         typename Lanes<W>::Ints& hi, typename Lanes<W>::Floats& fraction) {
@@ -153,7 +155,10 @@ template <int W>
     const Floats whole = floor_v<Ints>(x);
     const Ints i = convert<Ints>(whole);
     fraction = x - whole;
-    if (mode == WrapMode::repeat) {
+    if (mode == WrapMode::repeat && kPowerOfTwo) {
+        lo = i & (n_int - 1);
+        hi = (i + 1) & (n_int - 1);
+    } else if (mode == WrapMode::repeat) {
         lo = i < 0 ? i + n_int : i;
         hi = i + 1 >= n_int ? i + 1 - n_int : i + 1;
     } else {
@@ -219,24 +224,29 @@ template <int W>
 
 // Part two: the bilinear quads on level k and k + 1 (sizes max(1, ⌊w/2^k⌋), exact in float); only
 // on level k where no lane blends (λ an integer: an exact 2^k footprint, or magnification).
-template <int W>
+// kPowerOfTwo: both of the texture's sizes are powers of two (so are its levels').
+template <int W, bool kPowerOfTwo>
 [[gnu::always_inline]] inline void plan_quads(const LaneLevels<W>& lanes, int first, const Sampler& s, int width_texels,
                                               int height_texels, int levels, LanePlan& plan) {
     MIPRASTER_LANES(W);
-    const Floats width = splat<Floats>(static_cast<float>(width_texels)), height = splat<Floats>(static_cast<float>(height_texels));
     const Ints fine = lanes.fine;
     const Floats u = lanes.u, v = lanes.v;
     for (int step = 0; step < (lanes.blends ? 2 : 1); ++step) {
         const Ints k = min_v(fine + step, Ints{} + (levels - 1));
-        const Ints scale_bits = (127 - k) << 23;
-        const Floats scale = bits_as<Floats>(scale_bits);  // 2^−k
-        const Floats wk = max_v(convert<Floats>(convert<Ints>(width * scale)), splat<Floats>(1.0f));
-        const Floats hk = max_v(convert<Floats>(convert<Ints>(height * scale)), splat<Floats>(1.0f));
+        Ints wk_int, hk_int;
+        if constexpr (W == 8) {  // AVX2 shifts each lane by its own count
+            wk_int = max_v((Ints{} + width_texels) >> k, Ints{} + 1);
+            hk_int = max_v((Ints{} + height_texels) >> k, Ints{} + 1);
+        } else {
+            const Floats scale = bits_as<Floats>((127 - k) << 23);  // 2^−k
+            wk_int = max_v(convert<Ints>(static_cast<float>(width_texels) * scale), Ints{} + 1);
+            hk_int = max_v(convert<Ints>(static_cast<float>(height_texels) * scale), Ints{} + 1);
+        }
+        const Floats wk = convert<Floats>(wk_int), hk = convert<Floats>(hk_int);
         Ints i0, i1, j0, j1;
         Floats fx, fy;
-        axis<W>(u, wk, convert<Ints>(wk), s.wrap_u, i0, i1, fx);
-        axis<W>(v, hk, convert<Ints>(hk), s.wrap_v, j0, j1, fy);
-        const Ints wk_int = convert<Ints>(wk);
+        axis<W, kPowerOfTwo>(u, wk, wk_int, s.wrap_u, i0, i1, fx);
+        axis<W, kPowerOfTwo>(v, hk, hk_int, s.wrap_v, j0, j1, fy);
         const Ints row0 = j0 * wk_int, row1 = j1 * wk_int;
         // (Four stores, not a loop over an array of vectors: GCC copied such an array through the
         // stack in halves, and the reloads waited on the wide stores.)
@@ -256,16 +266,23 @@ template <int W>
 void plan_sse2(const LookupBatch& b, const float* rho2_scale, int count, const Sampler& s, int width, int height,
                int levels, LanePlan& plan) {
     for (int first = 0; first < count; first += 4)
-        plan_quads<4>(plan_levels<4>(b, rho2_scale, first, s, width, height, levels, plan), first, s, width, height,
-                      levels, plan);
+        plan_quads<4, false>(plan_levels<4>(b, rho2_scale, first, s, width, height, levels, plan), first, s, width,
+                             height, levels, plan);
 }
 #if defined(__x86_64__)
-[[gnu::target("avx2")]] void plan_avx2(const LookupBatch& b, const float* rho2_scale, int, const Sampler& s, int width,
-                                      int height, int levels, LanePlan& plan) {
+template <bool kPowerOfTwo>
+[[gnu::always_inline]] inline void plan_eight(const LookupBatch& b, const float* rho2_scale, const Sampler& s, int width,
+                                              int height, int levels, LanePlan& plan) {
     const LaneLevels<8> low = plan_levels<8>(b, rho2_scale, 0, s, width, height, levels, plan);
     const LaneLevels<8> high = plan_levels<8>(b, rho2_scale, 8, s, width, height, levels, plan);
-    plan_quads<8>(low, 0, s, width, height, levels, plan);
-    plan_quads<8>(high, 8, s, width, height, levels, plan);
+    plan_quads<8, kPowerOfTwo>(low, 0, s, width, height, levels, plan);
+    plan_quads<8, kPowerOfTwo>(high, 8, s, width, height, levels, plan);
+}
+[[gnu::target("avx2")]] void plan_avx2(const LookupBatch& b, const float* rho2_scale, int, const Sampler& s, int width,
+                                      int height, int levels, LanePlan& plan) {
+    const bool powers_of_two = (width & (width - 1)) == 0 && (height & (height - 1)) == 0;
+    if (powers_of_two) plan_eight<true>(b, rho2_scale, s, width, height, levels, plan);
+    else plan_eight<false>(b, rho2_scale, s, width, height, levels, plan);
 }
 #else  // (other CPUs: the four-lane path; never called)
 void plan_avx2(const LookupBatch& b, const float* rho2_scale, int count, const Sampler& s, int width, int height,
