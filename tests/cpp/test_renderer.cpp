@@ -32,6 +32,36 @@ mr::Mesh random_triangles(std::size_t n, double size, std::uint64_t seed) {
     return helpers::random_triangles(n, size, seed, {-2.0, -1.5, -2.0}, {4.0, 3.0, 8.0});
 }
 
+// A render of more set-up triangles than kStreamedSetupBytes stores their records with streaming
+// stores: 40,000 triangles on screen give the same image, depth and counters whether they are
+// drawn alone (kept in the cache) or with 40,000 more that lie off the screen (streamed).
+TEST(Renderer, SetUpRecordsStoredPastTheCacheGiveTheSameImage) {
+    const int W = 160, H = 120;
+    const std::size_t n = 40000;
+    static_assert(40000 * sizeof(mr::SetupTriangle) <= mr::kStreamedSetupBytes &&
+                  2 * 40000 * sizeof(mr::SetupTriangle) > mr::kStreamedSetupBytes);
+    const mr::Camera cam = mr::Camera::look_at_perspective({0.3, 1.0, 4.0}, {0, 0, 0}, {0, 1, 0}, 1.0, double(W) / H, 0.05);
+    const mr::Mesh on_screen = random_triangles(n, 0.15, 5), elsewhere = random_triangles(n, 0.15, 6);
+    glm::dmat4 aside(1.0);
+    aside[3] = glm::dvec4(1000.0, 0.0, 0.0, 1.0);
+    for (int threads : {1, 2})
+        for (int S : {1, 4}) {
+            SCOPED_TRACE(std::to_string(threads) + " threads, " + std::to_string(S) + " samples");
+            auto s = settings(W, H, S);
+            s.threads = threads;
+            const mr::RenderResult kept = mr::render({make_draw(on_screen, glm::dmat4(1.0), mr::DrawState{})}, cam, s);
+            const mr::RenderResult streamed = mr::render(
+                {make_draw(on_screen, glm::dmat4(1.0), mr::DrawState{}), make_draw(elsewhere, aside, mr::DrawState{})}, cam, s);
+            EXPECT_EQ(streamed.stats.triangles_outside, kept.stats.triangles_outside + n);
+            EXPECT_GT(kept.stats.samples_passed, 10000u * S);
+            EXPECT_TRUE(same_bits(streamed.color.pixels, kept.color.pixels)) << "resolved colour differs";
+            EXPECT_TRUE(same_bits(streamed.framebuffer.color, kept.framebuffer.color)) << "samples differ";
+            EXPECT_TRUE(same_bits(streamed.framebuffer.depth, kept.framebuffer.depth)) << "depth differs";
+            EXPECT_EQ(streamed.stats.samples_passed, kept.stats.samples_passed);
+            EXPECT_EQ(streamed.stats.shader_invocations, kept.stats.shader_invocations);
+        }
+}
+
 TEST(Renderer, OneTwoAndFourThreadsGiveBitIdenticalColourAndDepthForEveryBlendModeSsaaAndMsaa) {
     const int W = 160, H = 120;
     const mr::Camera cam = mr::Camera::look_at_perspective({0.3, 1.0, 4.0}, {0, 0, 0}, {0, 1, 0}, 1.0, double(W) / H, 0.05);

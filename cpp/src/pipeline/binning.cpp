@@ -95,25 +95,22 @@ ChunkBinner::ChunkBinner(BinnedChunk& chunk, const TileGrid& grid, bool overlap_
     reserve_on_huge_pages(spans_, chunk.triangles.capacity());
 }
 
-void ChunkBinner::add() {
-    for (std::size_t i = spans_.size(); i < chunk_.triangles.size(); ++i) {
-        const SetupTriangle& t = chunk_.triangles[i];
-        const auto tile_of = [](int pixel) { return static_cast<std::uint16_t>(pixel / kTileSize); };
-        const TileSpan span{tile_of(t.min_x), tile_of(t.min_y), tile_of(t.max_x), tile_of(t.max_y)};
-        spans_.push_back(span);
-        for (int ty = span.y0; ty <= span.y1; ++ty)
-            for (int tx = span.x0; tx <= span.x1; ++tx) {
-                const std::size_t tile = static_cast<std::size_t>(ty) * grid_.tiles_x + tx;
-                ++chunk_.tile_start[tile + 1];
-                if (!overlap_areas_) continue;
-                const int x0 = tx * kTileSize, y0 = ty * kTileSize;
-                const int x1 = std::min(x0 + kTileSize, grid_.width), y1 = std::min(y0 + kTileSize, grid_.height);
-                // (Most small triangles lie inside one tile: tile_overlap_area's first case, inline.)
-                chunk_.tile_area[tile] += box_inside(t, x0, y0, x1, y1)
-                                              ? box_share(t, t.min_x, t.min_y, t.max_x + 1, t.max_y + 1)
-                                              : tile_overlap_area(t, x0, y0, x1, y1);
-            }
-    }
+void ChunkBinner::add(const SetupTriangle& t) {
+    const auto tile_of = [](int pixel) { return static_cast<std::uint16_t>(pixel / kTileSize); };
+    const TileSpan span{tile_of(t.min_x), tile_of(t.min_y), tile_of(t.max_x), tile_of(t.max_y)};
+    spans_.push_back(span);
+    for (int ty = span.y0; ty <= span.y1; ++ty)
+        for (int tx = span.x0; tx <= span.x1; ++tx) {
+            const std::size_t tile = static_cast<std::size_t>(ty) * grid_.tiles_x + tx;
+            ++chunk_.tile_start[tile + 1];
+            if (!overlap_areas_) continue;
+            const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+            const int x1 = std::min(x0 + kTileSize, grid_.width), y1 = std::min(y0 + kTileSize, grid_.height);
+            // (Most small triangles lie inside one tile: tile_overlap_area's first case, inline.)
+            chunk_.tile_area[tile] += box_inside(t, x0, y0, x1, y1)
+                                          ? box_share(t, t.min_x, t.min_y, t.max_x + 1, t.max_y + 1)
+                                          : tile_overlap_area(t, x0, y0, x1, y1);
+        }
 }
 
 void ChunkBinner::finish() {
@@ -132,7 +129,7 @@ void ChunkBinner::finish() {
 
 void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas) {
     ChunkBinner binner(chunk, grid, overlap_areas);
-    binner.add();
+    for (const SetupTriangle& t : chunk.triangles) binner.add(t);
     binner.finish();
 }
 

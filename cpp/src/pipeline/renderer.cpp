@@ -9,6 +9,10 @@
 #include <stdexcept>
 #include <type_traits>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include "mipraster/core/constants.hpp"
 #include "mipraster/core/huge_pages.hpp"
 #include "mipraster/core/memory_limit.hpp"
@@ -78,8 +82,6 @@ constexpr std::size_t kVertexRun = 512;
 // Triangles per chunk: enough chunks for load balance, few enough that per-chunk tile tables stay
 // small. The split never changes the output (see BinnedChunk).
 constexpr std::size_t kMinChunkTriangles = 256;
-// Triangles set up before binning counts them (their set-up data, 32 KiB, stays in the L1 cache).
-constexpr std::uint32_t kBinRun = 256;
 
 void validate_draws(const std::vector<Draw>& draws) {
     for (std::size_t i = 0; i < draws.size(); ++i) {
@@ -137,72 +139,90 @@ void resolve_view_depth(const SampleWindow& depth, int x0, int y0, int x1, int y
         }
 }
 
-// Clip and set up one chunk of triangles, then bin them.
-void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices,
-                 const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid, bool overlap_areas,
-                 BinnedChunk& chunk, SetupCounters& counters, std::uint64_t& clipped) {
+// Appends a set-up triangle with streaming stores (kStreamedSetupBytes). (Readers on other
+// threads need the fence in setup_chunk first.)
+inline void append_streamed(RecycledVector<SetupTriangle>& triangles, const SetupTriangle& t) {
+    triangles.emplace_back();  // (default-initialized: nothing stored)
+#if defined(__SSE2__)
+    static_assert(sizeof(SetupTriangle) % 16 == 0 && kBlockAlignment % 16 == 0, "records on 16-byte boundaries");
+    const auto* from = reinterpret_cast<const __m128i*>(&t);
+    auto* to = reinterpret_cast<__m128i*>(&triangles.back());
+    for (std::size_t i = 0; i < sizeof(SetupTriangle) / 16; ++i) _mm_stream_si128(to + i, _mm_loadu_si128(from + i));
+#else
+    triangles.back() = t;
+#endif
+}
+
+// Clip, set up and bin one chunk of triangles (`streamed`: their records with streaming stores).
+void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices, const ClipVolume& volume,
+                 const Viewport& viewport, const TileGrid& grid, bool overlap_areas, bool streamed, BinnedChunk& chunk,
+                 SetupCounters& counters, std::uint64_t& clipped) {
     reserve_on_huge_pages(chunk.triangles, range.last - range.first);
     ChunkBinner binner(chunk, grid, overlap_areas);
+    const auto keep = [&](const SetupTriangle& t) {
+        binner.add(t);
+        if (streamed) append_streamed(chunk.triangles, t);
+        else chunk.triangles.push_back(t);
+    };
     SetupTriangle st;
     ClipPolygon polygon;
-    for (std::uint32_t run = range.first; run < range.last; run += kBinRun) {
-        for (std::uint32_t t = run; t < std::min(range.last, run + kBinRun); ++t) {
-            const glm::uvec3 tri = (*vertices.triangles)[t];
-            const std::array<std::uint8_t, 3> codes = {vertices.outcodes[tri[0]], vertices.outcodes[tri[1]],
-                                                       vertices.outcodes[tri[2]]};
-            if ((codes[0] | codes[1] | codes[2]) & kNonFinite) {
-                ++counters.dropped_nonfinite;
-                continue;
-            }
-            st.triangle = t;
-            st.draw = range.draw;
-            if ((codes[0] | codes[1] | codes[2]) == 0) {  // inside: its vertices are projected already
-                st.clip_index = -1;
-                const std::array<ScreenVertex, 3> v = {vertices.screen[tri[0]], vertices.screen[tri[1]],
-                                                       vertices.screen[tri[2]]};
-                if (setup_triangle(v, viewport, vertices.cull, st, counters))
-                    chunk.triangles.push_back(st);
-                continue;
-            }
-            const std::array<glm::dvec4, 3> p = {vertices.positions[tri[0]], vertices.positions[tri[1]],
-                                                 vertices.positions[tri[2]]};
-            switch (clip_triangle(p, codes, volume, polygon)) {
-                case ClipOutcome::inside:  // (only for outcodes that OR to 0: set up above)
-                case ClipOutcome::outside: ++counters.culled_outside; break;
-                case ClipOutcome::clipped: {
-                    ++clipped;
-                    if (projects_to_a_line(p)) {  // zero area: clipping would round area into it
-                        ++counters.culled_degenerate;
-                        break;
-                    }
-                    // Fan-triangulate the clipped polygon; each piece keeps its original-triangle weights.
-                    SetupCounters pieces;
-                    bool any = false;
-                    for (int i = 1; i + 1 < polygon.count; ++i) {
-                        const ClipVertex* v[3] = {&polygon.vertices[0], &polygon.vertices[i], &polygon.vertices[i + 1]};
-                        st.clip_index = static_cast<std::int32_t>(chunk.clip_weights.size());
-                        const std::array<glm::dvec4, 3> piece = {v[0]->position, v[1]->position, v[2]->position};
-                        if (setup_triangle(piece, viewport, vertices.cull, st, pieces)) {
-                            any = true;
-                            chunk.triangles.push_back(st);
-                            chunk.clip_weights.push_back(
-                                {glm::vec3(v[0]->weights), glm::vec3(v[1]->weights), glm::vec3(v[2]->weights)});
-                        }
-                    }
-                    // The counters count submitted triangles: a clipped one that drew nothing counts
-                    // once, under the first reason that applies to its pieces.
-                    if (!any) {
-                        if (pieces.culled_backface) ++counters.culled_backface;
-                        else if (pieces.dropped_nonfinite) ++counters.dropped_nonfinite;
-                        else if (pieces.culled_outside) ++counters.culled_outside;
-                        else ++counters.culled_degenerate;
-                    }
+    for (std::uint32_t t = range.first; t < range.last; ++t) {
+        const glm::uvec3 tri = (*vertices.triangles)[t];
+        const std::array<std::uint8_t, 3> codes = {vertices.outcodes[tri[0]], vertices.outcodes[tri[1]],
+                                                   vertices.outcodes[tri[2]]};
+        if ((codes[0] | codes[1] | codes[2]) & kNonFinite) {
+            ++counters.dropped_nonfinite;
+            continue;
+        }
+        st.triangle = t;
+        st.draw = range.draw;
+        if ((codes[0] | codes[1] | codes[2]) == 0) {  // inside: its vertices are projected already
+            st.clip_index = -1;
+            const std::array<ScreenVertex, 3> v = {vertices.screen[tri[0]], vertices.screen[tri[1]],
+                                                   vertices.screen[tri[2]]};
+            if (setup_triangle(v, viewport, vertices.cull, st, counters)) keep(st);
+            continue;
+        }
+        const std::array<glm::dvec4, 3> p = {vertices.positions[tri[0]], vertices.positions[tri[1]],
+                                             vertices.positions[tri[2]]};
+        switch (clip_triangle(p, codes, volume, polygon)) {
+            case ClipOutcome::inside:  // (only for outcodes that OR to 0: set up above)
+            case ClipOutcome::outside: ++counters.culled_outside; break;
+            case ClipOutcome::clipped: {
+                ++clipped;
+                if (projects_to_a_line(p)) {  // zero area: clipping would round area into it
+                    ++counters.culled_degenerate;
                     break;
                 }
+                // Fan-triangulate the clipped polygon; each piece keeps its original-triangle weights.
+                SetupCounters pieces;
+                bool any = false;
+                for (int i = 1; i + 1 < polygon.count; ++i) {
+                    const ClipVertex* v[3] = {&polygon.vertices[0], &polygon.vertices[i], &polygon.vertices[i + 1]};
+                    st.clip_index = static_cast<std::int32_t>(chunk.clip_weights.size());
+                    const std::array<glm::dvec4, 3> piece = {v[0]->position, v[1]->position, v[2]->position};
+                    if (setup_triangle(piece, viewport, vertices.cull, st, pieces)) {
+                        any = true;
+                        keep(st);
+                        chunk.clip_weights.push_back(
+                            {glm::vec3(v[0]->weights), glm::vec3(v[1]->weights), glm::vec3(v[2]->weights)});
+                    }
+                }
+                // The counters count submitted triangles: a clipped one that drew nothing counts
+                // once, under the first reason that applies to its pieces.
+                if (!any) {
+                    if (pieces.culled_backface) ++counters.culled_backface;
+                    else if (pieces.dropped_nonfinite) ++counters.dropped_nonfinite;
+                    else if (pieces.culled_outside) ++counters.culled_outside;
+                    else ++counters.culled_degenerate;
+                }
+                break;
             }
         }
-        binner.add();  // (the run's set-up triangles are still in cache)
     }
+#if defined(__SSE2__)
+    if (streamed) _mm_sfence();  // (the streaming stores before the hand-off to the threads that rasterize)
+#endif
     binner.finish();
 }
 
@@ -220,11 +240,12 @@ std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geo
         for (std::size_t first = 0; first < n; first += size)
             ranges.push_back({d, static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(std::min(n, first + size))});
     }
+    const bool streamed = stats.triangles_in * sizeof(SetupTriangle) > kStreamedSetupBytes;
     std::vector<BinnedChunk> chunks(ranges.size());
     std::vector<SetupCounters> setup_counters(ranges.size());
     std::vector<std::uint64_t> clipped(ranges.size(), 0);
     pool.parallel_for(ranges.size(), [&](std::size_t i) {
-        setup_chunk(ranges[i], geometry[ranges[i].draw], volume, viewport, grid, overlap_areas, chunks[i],
+        setup_chunk(ranges[i], geometry[ranges[i].draw], volume, viewport, grid, overlap_areas, streamed, chunks[i],
                     setup_counters[i], clipped[i]);
     });
     for (std::size_t i = 0; i < ranges.size(); ++i) {

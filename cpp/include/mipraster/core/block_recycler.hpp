@@ -8,6 +8,8 @@
 // kMaxRecycledTotalBytes in all, the oldest freed first (constants.hpp); thread-safe.
 #include <cstddef>
 #include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace mipraster {
@@ -44,6 +46,17 @@ struct RecyclingAllocator {
     }
     void deallocate(T* p, std::size_t n) noexcept {
         if (!recycle_block(p, n * sizeof(T))) ::operator delete(p, std::align_val_t{kBlockAlignment});
+    }
+    /// resize() and emplace_back() without arguments default-initialize: a type without a
+    /// constructor is left as it is, not zeroed (every user writes what it sizes, and zeroing a
+    /// buffer larger than the cache first reads each of its lines from memory).
+    template <typename U>
+    void construct(U* p) noexcept(std::is_nothrow_default_constructible<U>::value) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <typename U, typename... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
     }
     template <typename U>
     bool operator==(const RecyclingAllocator<U>&) const noexcept {

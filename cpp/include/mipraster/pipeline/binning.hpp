@@ -37,16 +37,16 @@ struct BinnedChunk {
 /// bounding box it fills.
 double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1);
 
-/// Bins a chunk while setup makes its triangles (a counting sort): add() after each run of new
-/// triangles counts their tiles (and, when `overlap_areas`, adds up chunk.tile_area) while they
-/// are still in cache, finish() places them in chunk.tile_start / tile_triangles. Each
-/// triangle's tile range is kept for finish() in 8 bytes, so no pass reads the triangles again:
-/// a million of them are 128 MB, and reading them back from memory was a sixth of a frame.
+/// Bins a chunk while setup makes its triangles (a counting sort): add() counts each new
+/// triangle's tiles (and, when `overlap_areas`, adds up chunk.tile_area) from the set-up record
+/// at hand, finish() places them in chunk.tile_start / tile_triangles from each triangle's tile
+/// range, kept in 8 bytes. No pass reads the triangles back: a million of them are 128 MB, and
+/// reading them from memory twice was a sixth of a frame.
 class ChunkBinner {
 public:
     ChunkBinner(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas);
-    /// Counts the triangles added to chunk.triangles since the last call.
-    void add();
+    /// Counts t, the triangle that becomes chunk.triangles[n] for the n-th call.
+    void add(const SetupTriangle& t);
     /// Fills chunk.tile_start and chunk.tile_triangles (after the last add()).
     void finish();
 
@@ -60,7 +60,7 @@ private:
     RecycledVector<TileSpan> spans_;
 };
 
-/// All of a chunk's triangles at once: ChunkBinner's add() and finish().
+/// All of chunk.triangles at once: ChunkBinner's add() for each, then finish().
 void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas);
 
 }  // namespace mipraster
