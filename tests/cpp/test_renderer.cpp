@@ -40,7 +40,8 @@ TEST(Renderer, SetUpRecordsStoredPastTheCacheGiveTheSameImage) {
     const std::size_t n = 40000;
     static_assert(40000 * sizeof(mr::SetupTriangle) <= mr::kStreamedSetupBytes &&
                   2 * 40000 * sizeof(mr::SetupTriangle) > mr::kStreamedSetupBytes);
-    const mr::Camera cam = mr::Camera::look_at_perspective({0.3, 1.0, 4.0}, {0, 0, 0}, {0, 1, 0}, 1.0, double(W) / H, 0.05);
+    const mr::Camera cam =
+        mr::Camera::look_at_perspective({0.3, 1.0, 4.0}, {0, 0, 0}, {0, 1, 0}, 1.0, double(W) / H, 0.05);
     const mr::Mesh on_screen = random_triangles(n, 0.15, 5), elsewhere = random_triangles(n, 0.15, 6);
     glm::dmat4 aside(1.0);
     aside[3] = glm::dvec4(1000.0, 0.0, 0.0, 1.0);
@@ -49,9 +50,9 @@ TEST(Renderer, SetUpRecordsStoredPastTheCacheGiveTheSameImage) {
             SCOPED_TRACE(std::to_string(threads) + " threads, " + std::to_string(S) + " samples");
             auto s = settings(W, H, S);
             s.threads = threads;
-            const mr::RenderResult kept = mr::render({make_draw(on_screen, glm::dmat4(1.0), mr::DrawState{})}, cam, s);
-            const mr::RenderResult streamed = mr::render(
-                {make_draw(on_screen, glm::dmat4(1.0), mr::DrawState{}), make_draw(elsewhere, aside, mr::DrawState{})}, cam, s);
+            const mr::Draw drawn = make_draw(on_screen, glm::dmat4(1.0), mr::DrawState{});
+            const mr::RenderResult kept = mr::render({drawn}, cam, s);
+            const mr::RenderResult streamed = mr::render({drawn, make_draw(elsewhere, aside, mr::DrawState{})}, cam, s);
             EXPECT_EQ(streamed.stats.triangles_outside, kept.stats.triangles_outside + n);
             EXPECT_GT(kept.stats.samples_passed, 10000u * S);
             EXPECT_TRUE(same_bits(streamed.color.pixels, kept.color.pixels)) << "resolved colour differs";
@@ -175,6 +176,47 @@ TEST(Renderer, IndexOutOfRangeThrowsNamingTheTriangle) {
         {make_draw(ok, glm::dmat4(1.0), no_depth()), make_draw(m, glm::dmat4(1.0), no_depth())}, settings(8, 8));
     EXPECT_MESSAGE_HAS(msg, "triangles[5]");
     EXPECT_MESSAGE_HAS(msg, "draws[1]");
+}
+
+// Mesh::validate checks all components at once before it looks for the first bad one: on random
+// meshes, one non-finite component anywhere (positions, colours or uvs) or one index past the
+// last vertex is named, and the finite extremes (±float max, the smallest subnormal, −0) and the
+// last vertex's index pass.
+TEST(Renderer, MeshValidationNamesEveryBadEntryAndPassesTheFiniteExtremes) {
+    std::mt19937_64 rng(47);
+    const float kInf = std::numeric_limits<float>::infinity();
+    const float bad[] = {std::numeric_limits<float>::quiet_NaN(), kInf, -kInf};
+    const float extreme[] = {std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(),
+                             std::numeric_limits<float>::denorm_min(), -0.0f};
+    const char* const axis = "xyz", *const channel = "rgba", *const uv = "uv";
+    for (int trial = 0; trial < 300; ++trial) {
+        const std::size_t n = 1 + rng() % 200;
+        mr::Mesh m = helpers::random_triangles(n, 0.5, rng(), {-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0});
+        m.uvs.assign(m.positions.size(), glm::vec2(0.5f));
+        const std::size_t v = rng() % m.positions.size(), t = rng() % m.triangles.size();
+        const int k = static_cast<int>(rng() % 3);
+        m.positions[v][k] = extreme[rng() % 4];
+        m.colors[v][3 - k] = extreme[rng() % 4];
+        m.triangles[t][k] = static_cast<std::uint32_t>(m.positions.size() - 1);
+        EXPECT_NO_THROW(m.validate("mesh")) << "trial " << trial;
+        mr::Mesh broken = m;
+        std::string expected;
+        const std::string at = "[" + std::to_string(v) + "].";
+        switch (trial % 4) {
+            case 0: broken.positions[v][k] = bad[rng() % 3], expected = ".positions" + at + axis[k]; break;
+            case 1: broken.colors[v][k] = bad[rng() % 3], expected = ".colors" + at + channel[k]; break;
+            case 2: broken.uvs[v][k % 2] = bad[rng() % 3], expected = ".uvs" + at + uv[k % 2]; break;
+            default:
+                broken.triangles[t][k] = static_cast<std::uint32_t>(m.positions.size() + rng() % 3);
+                expected = ".triangles[" + std::to_string(t) + "][" + std::to_string(k) + "]";
+        }
+        try {
+            broken.validate("mesh");
+            ADD_FAILURE() << "trial " << trial << ": " << expected << " not refused";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_MESSAGE_HAS(std::string(e.what()), expected);
+        }
+    }
 }
 
 TEST(Renderer, ColourArrayOfTheWrongSizeThrowsNamingIt) {
