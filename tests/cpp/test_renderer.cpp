@@ -204,7 +204,11 @@ TEST(Renderer, MeshValidationNamesEveryBadEntryAndPassesTheFiniteExtremes) {
         const std::string at = "[" + std::to_string(v) + "].";
         switch (trial % 4) {
             case 0: broken.positions[v][k] = bad[rng() % 3], expected = ".positions" + at + axis[k]; break;
-            case 1: broken.colors[v][k] = bad[rng() % 3], expected = ".colors" + at + channel[k]; break;
+            case 1: {  // (any of the four channels)
+                const int c = (k + trial / 4) % 4;
+                broken.colors[v][c] = bad[rng() % 3], expected = ".colors" + at + channel[c];
+                break;
+            }
             case 2: broken.uvs[v][k % 2] = bad[rng() % 3], expected = ".uvs" + at + uv[k % 2]; break;
             default:
                 broken.triangles[t][k] = static_cast<std::uint32_t>(m.positions.size() + rng() % 3);
