@@ -245,8 +245,12 @@ std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geo
     std::vector<SetupCounters> setup_counters(ranges.size());
     std::vector<std::uint64_t> clipped(ranges.size(), 0);
     pool.parallel_for(ranges.size(), [&](std::size_t i) {
+        SetupCounters counters;  // (stored once: neighbouring chunks' counters share cache lines)
+        std::uint64_t clipped_here = 0;
         setup_chunk(ranges[i], geometry[ranges[i].draw], volume, viewport, grid, overlap_areas, streamed, chunks[i],
-                    setup_counters[i], clipped[i]);
+                    counters, clipped_here);
+        setup_counters[i] = counters;
+        clipped[i] = clipped_here;
     });
     for (std::size_t i = 0; i < ranges.size(); ++i) {
         stats.triangles_clipped += clipped[i];
