@@ -320,30 +320,35 @@ double triangle_in_rectangle(const std::array<glm::dvec2, 3>& v, double x0, doub
 // are the same either way, and the sums are those of tile_overlap_area over each tile's triangles.
 TEST(DeferredShading, BinningAddsOverlapAreasOnlyWhenAsked) {
     std::mt19937_64 rng(45);
-    const int N = 200;  // 7×7 tiles, the last row and column partial
-    const mr::TileGrid grid = mr::TileGrid::for_viewport(N, N);
-    mr::BinnedChunk with, without;
-    for (int k = 0; k < 400; ++k) {
-        mr::SetupTriangle t;
-        if (set_up(random_screen_triangle(rng, std::array<double, 3>{3.0, 40.0, 300.0}[k % 3], N), N, t)) {
-            with.triangles.push_back(t);
-            without.triangles.push_back(t);
+    // 7×7 and 22×22 tiles, the last row and column partial; triangles from a few pixels to wider
+    // than the screen.
+    for (const int N : {200, 700}) {
+        SCOPED_TRACE(std::to_string(N) + "×" + std::to_string(N));
+        const mr::TileGrid grid = mr::TileGrid::for_viewport(N, N);
+        mr::BinnedChunk with, without;
+        for (int k = 0; k < 400; ++k) {
+            const double size = std::array<double, 4>{3.0, 40.0, 300.0, 2000.0}[k % 4];
+            mr::SetupTriangle t;
+            if (set_up(random_screen_triangle(rng, size, N), N, t)) {
+                with.triangles.push_back(t);
+                without.triangles.push_back(t);
+            }
         }
-    }
-    mr::bin_triangles(with, grid, true);
-    mr::bin_triangles(without, grid, false);
-    EXPECT_EQ(with.tile_start, without.tile_start);
-    EXPECT_TRUE(std::equal(with.tile_triangles.begin(), with.tile_triangles.end(), without.tile_triangles.begin(),
-                           without.tile_triangles.end()));
-    EXPECT_TRUE(without.tile_area.empty());
-    ASSERT_EQ(with.tile_area.size(), static_cast<std::size_t>(grid.count()));
-    for (int tile = 0; tile < grid.count(); ++tile) {
-        const int x0 = tile % grid.tiles_x * mr::kTileSize, y0 = tile / grid.tiles_x * mr::kTileSize;
-        double sum = 0.0;
-        for (std::uint32_t i = with.tile_start[tile]; i < with.tile_start[tile + 1]; ++i)
-            sum += mr::tile_overlap_area(with.triangles[with.tile_triangles[i]], x0, y0,
-                                         std::min(x0 + mr::kTileSize, N), std::min(y0 + mr::kTileSize, N));
-        EXPECT_EQ(with.tile_area[static_cast<std::size_t>(tile)], sum) << "tile " << tile;
+        mr::bin_triangles(with, grid, true);
+        mr::bin_triangles(without, grid, false);
+        EXPECT_EQ(with.tile_start, without.tile_start);
+        EXPECT_TRUE(std::equal(with.tile_triangles.begin(), with.tile_triangles.end(), without.tile_triangles.begin(),
+                               without.tile_triangles.end()));
+        EXPECT_TRUE(without.tile_area.empty());
+        ASSERT_EQ(with.tile_area.size(), static_cast<std::size_t>(grid.count()));
+        for (int tile = 0; tile < grid.count(); ++tile) {
+            const int x0 = tile % grid.tiles_x * mr::kTileSize, y0 = tile / grid.tiles_x * mr::kTileSize;
+            double sum = 0.0;
+            for (std::uint32_t i = with.tile_start[tile]; i < with.tile_start[tile + 1]; ++i)
+                sum += mr::tile_overlap_area(with.triangles[with.tile_triangles[i]], x0, y0,
+                                             std::min(x0 + mr::kTileSize, N), std::min(y0 + mr::kTileSize, N));
+            EXPECT_EQ(with.tile_area[static_cast<std::size_t>(tile)], sum) << "tile " << tile;
+        }
     }
 }
 
