@@ -46,11 +46,13 @@ struct Viewport {
 /// A clip-space vertex on the screen: its position snapped to 1/256 px (y down), its window depth
 /// and 1/w. Not valid (inv_w = 0) when a projected coordinate is not finite or beyond
 /// kMaxFixedCoordinate, or 1/w is not a positive normal double; the other fields are then
-/// meaningless. (24 bytes: setup reads three per triangle.)
+/// meaningless. (24 bytes: setup reads three per triangle. No default values: a frame's array of
+/// them is sized, then written only where a vertex is inside the clip volume; ScreenVertex{} is
+/// all zeros.)
 struct ScreenVertex {
-    std::int32_t x = 0, y = 0;
-    double inv_w = 0.0;
-    double depth = 0.0;
+    std::int32_t x, y;
+    double inv_w;
+    double depth;
     bool valid() const { return inv_w > 0.0; }
 };
 static_assert(sizeof(ScreenVertex) == 24);
@@ -67,7 +69,7 @@ inline ScreenVertex project_vertex(const glm::dvec4& p, const Viewport& viewport
     const double xs = std::nearbyint((p.x * inv_w + 1.0) * half_w * kSubpixelOne);
     const double ys = std::nearbyint((1.0 - p.y * inv_w) * half_h * kSubpixelOne);
     const double z = p.z * inv_w;
-    ScreenVertex v;
+    ScreenVertex v{};
     v.depth = viewport.depth_convention == DepthConvention::opengl ? 0.5 * z + 0.5 : z;
     // Only finite, in-range values may be converted to integers. Clipping keeps w ≥ kMinClipW, so
     // 1/w is positive; a vertex that breaks this is not projected.
