@@ -150,6 +150,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             off2[s] = std::int64_t{t.edge_a[2]} * pattern.x[s] + std::int64_t{t.edge_b[2]} * pattern.y[s];
         }
         const std::int64_t step0 = t.edge_a[0] * kStep, step1 = t.edge_a[1] * kStep, step2 = t.edge_a[2] * kStep;
+        // Edge offsets of a pixel's centre from its corner (MSAA shades there when it is inside).
+        const std::int64_t to_centre0 = (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * (kStep / 2);
+        const std::int64_t to_centre1 = (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * (kStep / 2);
+        const std::int64_t to_centre2 = (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * (kStep / 2);
         // MSAA with a depth test: the samples of a pixel the triangle covers whole tested four per
         // vector (pixel_samples.hpp). Pixels on its edges, with a few samples covered, and the
         // pixels of small triangles take less time one sample at a time (many_small MSAA 4x was
@@ -234,10 +238,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             if (!pixels) return;
             blocks.written_row(py, rx0, pixels);
             counters.shader_invocations += static_cast<std::uint64_t>(count_bits(pixels));
-            const std::int64_t half = kStep / 2;
-            const std::int64_t centre[3] = {corner[0] + (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * half,
-                                            corner[1] + (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * half,
-                                            corner[2] + (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * half};
+            const std::int64_t centre[3] = {corner[0] + to_centre0, corner[1] + to_centre1, corner[2] + to_centre2};
             double l0[kTileSize], l1[kTileSize], l2[kTileSize];
             sample_row_weights(t, centre, n, l0, l1, l2);  // (exact: the centres lie within the row's pixels)
             for (std::uint32_t m = pixels; m; m &= m - 1) {
@@ -375,10 +376,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
                     if constexpr (!((kShading == Shading::constant || kShading == Shading::flat) &&
                                     kTexturing == Texturing::none)) {
-                        const std::int64_t half = kStep / 2;
-                        std::int64_t c0 = p0 + (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * half;
-                        std::int64_t c1 = p1 + (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * half;
-                        std::int64_t c2 = p2 + (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * half;
+                        std::int64_t c0 = p0 + to_centre0, c1 = p1 + to_centre1, c2 = p2 + to_centre2;
                         if ((c0 | c1 | c2) < 0) {
                             const int s = __builtin_ctzll(passed);
                             c0 = p0 + off0[s];
