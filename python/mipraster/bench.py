@@ -14,10 +14,11 @@ Usage::
                               [--no-anchor] [--quick] [--out DIR] [--bench-dir DIR] [--roofline [PATH]]
     python -m mipraster.bench --growth [--quick] [--out DIR]       # cost growth (growth.py)
     python -m mipraster.bench --omissions [--quick] [--out DIR]    # what omissions save (omissions.py)
+    python -m mipraster.bench --aniso-cost [--quick] [--out DIR]   # anisotropic vs trilinear (aniso_cost.py)
 
 ``--roofline`` adds each case's roofline (roofline.py): the least time its framebuffer writes and
 texture lookups need at the machine's measured limits, and the fraction of it the frame reaches.
-``--growth`` and ``--omissions`` run their study instead of the scene matrix.
+``--growth``, ``--omissions`` and ``--aniso-cost`` run their study instead of the scene matrix.
 
 A frame is what llvmpipe's is: clear, draw, resolve, and the image in a numpy array (mipraster
 renders straight into one). Scene construction (meshes, textures) is outside the timed frame, as
@@ -266,6 +267,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                          "it wrote (default: $MIPRASTER_BENCH_ROOFLINE, PATH, next to the mipraster command)")
     ap.add_argument("--growth", action="store_true", help="run the cost-growth study instead (growth.py)")
     ap.add_argument("--omissions", action="store_true", help="run the omission table instead (omissions.py)")
+    ap.add_argument("--aniso-cost", action="store_true",
+                    help="time anisotropic filtering against trilinear on the 1080p plane instead (aniso_cost.py)")
     args = ap.parse_args(argv)
     for t in args.threads:
         if t < 1:
@@ -277,14 +280,16 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         ap.error(f"--min-time: {args.min_time} is not a finite number of seconds (>= 0)")
     if args.quick:
         args.min_frames, args.min_time, args.max_frames = 3, 0.2, 5
-    if args.growth or args.omissions:
-        from . import growth, omissions
+    if args.growth or args.omissions or args.aniso_cost:
+        from . import aniso_cost, growth, omissions
 
         os.makedirs(args.out, exist_ok=True)
         if args.growth:
             growth.run(args.out, quick=args.quick)
         if args.omissions:
             omissions.run(args.out, quick=args.quick)
+        if args.aniso_cost:
+            aniso_cost.run(args.out, quick=args.quick, bench_dir=args.bench_dir)
         return 0
 
     import mipraster as mr
