@@ -18,17 +18,14 @@
 #include "mipraster/core/colour.hpp"
 #include "mipraster/core/image.hpp"
 #include "mipraster/io/image_io.hpp"
+#include "test_output.hpp"
 
 namespace fs = std::filesystem;
 namespace mr = mipraster;
 
 namespace {
 
-std::string output_path(const std::string& name) {
-    const fs::path dir = fs::path(MIPRASTER_TEST_OUTPUT_DIR) / "image_io";
-    fs::create_directories(dir);
-    return (dir / name).string();
-}
+std::string output_path(const std::string& name) { return test_output_path("image_io", name); }
 
 // The raw 8-bit channels of a file as stored (straight alpha, no colour conversion).
 struct RawBytes {

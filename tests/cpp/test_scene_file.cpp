@@ -20,17 +20,14 @@
 #include "mipraster/io/image_io.hpp"
 #include "mipraster/io/scene_file.hpp"
 #include "mipraster/io/texture_file.hpp"
+#include "test_output.hpp"
 
 namespace fs = std::filesystem;
 namespace mr = mipraster;
 
 namespace {
 
-std::string output_path(const std::string& name) {
-    const fs::path dir = fs::path(MIPRASTER_TEST_OUTPUT_DIR) / "scene_file";
-    fs::create_directories(dir);
-    return (dir / name).string();
-}
+std::string output_path(const std::string& name) { return test_output_path("scene_file", name); }
 
 std::string write_file(const std::string& name, const std::string& bytes) {
     const std::string path = output_path(name);
