@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
 #include <functional>
 #include <fstream>
 #include <stdexcept>
@@ -22,7 +21,6 @@
 #include "mipraster/io/texture_file.hpp"
 #include "test_output.hpp"
 
-namespace fs = std::filesystem;
 namespace mr = mipraster;
 
 namespace {
