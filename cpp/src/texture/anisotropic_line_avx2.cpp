@@ -130,16 +130,12 @@ bool vectors_reach(const ProbeLine& g, const TextureLevel& level) {
     return vectors_reach(g, level) ? line_mean(level, g, count, s) : anisotropic_line(level, s, u, v, du, dv, count);
 }
 
-// probe_line on two levels at once, for repeat and clamp: [x on a, x on b, y on a, y on b] in one
-// vector, each element the same double arithmetic as probe_line's (its std::min and std::max
-// as selects), the wrap's division four at a time instead of one per level and axis.
+// probe_line on two levels at once, for repeat and clamp (the samplers BatchSampler covers, as
+// wrap() above): [x on a, x on b, y on a, y on b] in one vector, each element the same double
+// arithmetic as probe_line's (its std::min and std::max as selects), the wrap's division four at
+// a time instead of one per level and axis.
 [[gnu::target("avx2")]] void probe_lines(const TextureLevel& a, const TextureLevel& b, const Sampler& s, double u,
                                          double v, double du, double dv, int count, ProbeLine& ga, ProbeLine& gb) {
-    const auto covered = [](WrapMode m) { return m == WrapMode::repeat || m == WrapMode::clamp; };
-    if (!covered(s.wrap_u) || !covered(s.wrap_v)) {
-        ga = probe_line(a, s, u, v, du, dv, count), gb = probe_line(b, s, u, v, du, dv, count);
-        return;
-    }
     const __m256d size = _mm256_setr_pd(a.width, b.width, a.height, b.height);
     const __m256d x = _mm256_mul_pd(_mm256_setr_pd(u, u, v, v), size);
     const __m256d repeats = _mm256_castsi256_pd(_mm256_setr_epi64x(-(s.wrap_u == WrapMode::repeat),
