@@ -227,13 +227,14 @@ private:
 };
 
 /// A random sampler that covers() takes: linear filters, mip none or linear, isotropic or
-/// anisotropic (max 1, 4 or 16), repeat or clamp per axis, bias in [−2, 2], LOD clamps varied.
+/// anisotropic (max 1, 4, 16 or 40: lines longer than the 16 probes the AVX2 path places at a
+/// time), repeat or clamp per axis, bias in [−2, 2], LOD clamps varied.
 mr::Sampler covered_sampler(LookupGen& g) {
     mr::Sampler s;
     s.mip_filter = g.integer(0, 3) ? mr::MipFilter::linear : mr::MipFilter::none;
     s.footprint = g.integer(0, 1) ? mr::FootprintFilter::anisotropic : mr::FootprintFilter::isotropic;
-    const float anisotropy[] = {1.0f, 4.0f, 16.0f};
-    s.max_anisotropy = anisotropy[g.integer(0, 2)];
+    const float anisotropy[] = {1.0f, 4.0f, 16.0f, 40.0f};
+    s.max_anisotropy = anisotropy[g.integer(0, 3)];
     s.wrap_u = g.integer(0, 1) ? mr::WrapMode::repeat : mr::WrapMode::clamp;
     s.wrap_v = g.integer(0, 1) ? mr::WrapMode::repeat : mr::WrapMode::clamp;
     if (g.integer(0, 1)) s.lod_bias = float(g.uniform(-2.0, 2.0));  // else 0: the plain-magnification shortcut

@@ -3,6 +3,7 @@
 // needing several probes (private to the texture module; defined in sample.cpp, the AVX2 line in
 // anisotropic_line_avx2.cpp), so that both decide magnification and step along the line with the
 // same arithmetic.
+#include "mipraster/texture/sample_batch.hpp"
 #include "mipraster/texture/sampler.hpp"
 #include "mipraster/texture/texture_level.hpp"
 #include "texel.hpp"
@@ -33,14 +34,21 @@ ProbeLine probe_line(const TextureLevel& level, const Sampler& sampler, double u
 texel::Texel anisotropic_line(const TextureLevel& level, const Sampler& sampler, double u, double v, double du,
                               double dv, int count);
 
-/// anisotropic_line's bits with AVX2 (anisotropic_line_avx2.cpp), for repeat and clamp: the
-/// probes' positions and indices four per vector. Only on a CPU with AVX2.
-texel::Texel anisotropic_line_avx2(const TextureLevel& level, const Sampler& sampler, double u, double v, double du,
-                                   double dv, int count);
+/// The lanes of a lookup batch that take lines of probes: lane i's lookup (u, v), its longer
+/// derivative (du, dv), its probe count and the level(s) it reads (coarser null: one level).
+struct LineLanes {
+    int n = 0;
+    double u[kLookupBatch], v[kLookupBatch], du[kLookupBatch], dv[kLookupBatch];
+    int count[kLookupBatch];
+    const TextureLevel* finer[kLookupBatch];
+    const TextureLevel* coarser[kLookupBatch];
+};
 
-/// anisotropic_line_avx2 on two levels at once (a lookup that blends them): the same bits as two
-/// calls, the two lines' sums side by side so that their chains of additions overlap.
-void anisotropic_lines_avx2(const TextureLevel& a, const TextureLevel& b, const Sampler& sampler, double u, double v,
-                            double du, double dv, int count, texel::Texel& mean_a, texel::Texel& mean_b);
+/// anisotropic_line's bits with AVX2 (anisotropic_line_avx2.cpp), for repeat and clamp, for every
+/// lane i < lanes.n: mean_finer[i] on *finer[i] and, where coarser[i] is not null, mean_coarser[i]
+/// on *coarser[i]. The lines are placed four lanes per vector and their probes four per vector;
+/// a lookup's two lines are summed side by side. Only on a CPU with AVX2.
+void anisotropic_line_means_avx2(const LineLanes& lanes, const Sampler& sampler, texel::Texel* mean_finer,
+                                 texel::Texel* mean_coarser);
 
 }  // namespace mipraster

@@ -1,8 +1,15 @@
-// anisotropic_line with AVX2 (anisotropic_line.hpp), for the samplers BatchSampler covers. The
-// bits are the reference's: each probe's position is the same double arithmetic, four per vector
-// instead of two, with ⌊x⌋ one rounding instruction (exact) instead of a truncation and a compare;
-// its quad is the same four texels blended the same way; the line's sum runs in probe order. A
-// line that reaches outside the level wraps four indices per vector instead of texel by texel.
+// anisotropic_line with AVX2 (anisotropic_line.hpp) for the lanes of a lookup batch that take lines
+// of probes, for the samplers BatchSampler covers (repeat and clamp). The bits are the reference's:
+// each line's placement and each probe's position are the same double arithmetic, with ⌊x⌋ one
+// rounding instruction (exact) instead of a truncation and a compare; each quad is the same four
+// texels blended the same way; each line's sum runs in probe order. Indices outside a level wrap
+// four per vector instead of texel by texel.
+//
+// Four lanes go through at a time, each step for all four before the next: their lines placed
+// (one lane per vector element), their probes placed (probe k of the four lines in one vector),
+// then their sums. One lane at a time, each step waited for the one before it (a division,
+// roundings, conversions, stores and loads), and a lane's work was too long for the CPU to
+// overlap it with the next lane's; a short line also left most of its probe vector unused.
 #include <immintrin.h>
 
 #include <algorithm>
@@ -19,184 +26,232 @@ using namespace texel;
 
 namespace {
 
-constexpr int kChunk = 16;  // probes placed at a time
+constexpr int kChunk = 16;  // probes of each line placed at a time
 
-// wrap_index for repeat or clamp of four indices within ±(kProbeReach + 1). Repeat: a power-of-two
-// size masks (two's complement); another subtracts n·trunc(i/n), the quotient from a double
-// division. That remainder is in (−n, n) unless the division rounded across an integer (only for
-// n ≥ 2²³), which leaves it in (−2n, 2n); the last steps bring either into [0, n).
-[[gnu::target("avx2")]] inline __m128i wrap(__m128i i, int n, WrapMode mode) {
-    const __m128i size = _mm_set1_epi32(n);
-    if (mode == WrapMode::clamp) return _mm_min_epi32(_mm_max_epi32(i, _mm_setzero_si128()), _mm_set1_epi32(n - 1));
-    if ((n & (n - 1)) == 0) return _mm_and_si128(i, _mm_set1_epi32(n - 1));
-    const __m128i q = _mm256_cvttpd_epi32(_mm256_div_pd(_mm256_cvtepi32_pd(i), _mm256_set1_pd(n)));
+// wrap_index for repeat or clamp of four indices within ±(kProbeReach + 1), on levels of `size`
+// texels (per element). Repeat: powers of two mask (two's complement); other sizes subtract
+// n·trunc(i/n), the quotient from a double division. That remainder is in (−n, n) unless the
+// division rounded across an integer (only for n ≥ 2²³), which leaves it in (−2n, 2n); the last
+// steps bring either into [0, n). Both give the same index where both apply.
+[[gnu::target("avx2")]] inline __m128i wrap(__m128i i, __m128i size, bool powers_of_two, WrapMode mode) {
+    const __m128i zero = _mm_setzero_si128(), last = _mm_sub_epi32(size, _mm_set1_epi32(1));
+    if (mode == WrapMode::clamp) return _mm_min_epi32(_mm_max_epi32(i, zero), last);
+    if (powers_of_two) return _mm_and_si128(i, last);
+    const __m128i q = _mm256_cvttpd_epi32(_mm256_div_pd(_mm256_cvtepi32_pd(i), _mm256_cvtepi32_pd(size)));
     __m128i r = _mm_sub_epi32(i, _mm_mullo_epi32(q, size));  // within (−2n, 2n)
     for (int pass = 0; pass < 2; ++pass)  // r < 0: r + n
-        r = _mm_add_epi32(r, _mm_and_si128(_mm_cmpgt_epi32(_mm_setzero_si128(), r), size));
+        r = _mm_add_epi32(r, _mm_and_si128(_mm_cmpgt_epi32(zero, r), size));
     return _mm_sub_epi32(r, _mm_andnot_si128(_mm_cmpgt_epi32(size, r), size));  // r ≥ n: r − n
 }
 
-// Probes k0 … k0 + n − 1 of a line: for each, the quad's four texels (indices into the level) and
-// its fractions.
-struct Probes {
-    std::int32_t texel[4][kChunk];
-    float fx[kChunk], fy[kChunk];
+// probe_line's arithmetic on one axis of four lines (coordinate c, derivative d, level size n,
+// step 1/count and span (count − 1)·step per element): element by element the same double
+// operations, its std::min and std::max as selects. Gives the first probe's position and the
+// slope, and narrows `inside` and `near` by this axis (all-ones elements where they hold).
+[[gnu::target("avx2")]] inline void axis_lines(__m256d c, __m256d d, __m256d size, __m256d step, __m256d span,
+                                               WrapMode mode, __m256d& first, __m256d& slope, __m256d& inside,
+                                               __m256d& near) {
+    const __m256d x = _mm256_mul_pd(c, size);
+    if (mode == WrapMode::repeat) {  // reduce(): inside [0, n) it stays, else x − n·⌊x/n⌋
+        const __m256d inside_range = _mm256_and_pd(_mm256_cmp_pd(x, _mm256_setzero_pd(), _CMP_GE_OQ),
+                                                   _mm256_cmp_pd(x, size, _CMP_LT_OQ));
+        const __m256d periods = _mm256_round_pd(_mm256_div_pd(x, size), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+        const __m256d reduced = _mm256_sub_pd(x, _mm256_mul_pd(size, periods));
+        first = _mm256_blendv_pd(reduced, x, inside_range);
+    } else {
+        first = x;
+    }
+    slope = _mm256_mul_pd(d, size);
+    const __m256d half = _mm256_set1_pd(0.5);
+    first = _mm256_add_pd(_mm256_sub_pd(first, half), _mm256_mul_pd(_mm256_sub_pd(_mm256_mul_pd(half, step), half), slope));
+    const __m256d last = _mm256_add_pd(first, _mm256_mul_pd(span, slope));
+    const __m256d lo = _mm256_blendv_pd(first, last, _mm256_cmp_pd(last, first, _CMP_LT_OQ));  // std::min
+    const __m256d hi = _mm256_blendv_pd(first, last, _mm256_cmp_pd(first, last, _CMP_LT_OQ));  // std::max
+    inside = _mm256_and_pd(inside, _mm256_and_pd(_mm256_cmp_pd(lo, _mm256_setzero_pd(), _CMP_GE_OQ),
+                                                 _mm256_cmp_pd(hi, _mm256_sub_pd(size, _mm256_set1_pd(1.0)), _CMP_LT_OQ)));
+    const __m256d reach = _mm256_set1_pd(kProbeReach);
+    near = _mm256_and_pd(near, _mm256_and_pd(_mm256_cmp_pd(lo, _mm256_sub_pd(_mm256_setzero_pd(), reach), _CMP_GT_OQ),
+                                             _mm256_cmp_pd(hi, reach, _CMP_LT_OQ)));
+}
+
+// Four lines on one level each (element j: the line of lane j of a group): probe k of line j at
+// (x0 + k·step·sx, y0 + k·step·sy) in texels of a width × height level, as probe_line places it.
+struct FourLines {
+    __m256d x0, y0, sx, sy;
+    __m128i width, height;
+    bool powers_of_two;  // every element's width and height
+    int inside, near;    // bit j: line j's quads all lie inside its level / within ±kProbeReach
 };
 
-[[gnu::target("avx2")]] void place(const ProbeLine& g, int k0, int n, int w, int h, bool wraps, const Sampler& s,
-                                   Probes& p) {
-    const __m256d step = _mm256_set1_pd(g.step);
-    for (int c = 0; c < n; c += 4) {  // (a last partial vector places probes past the line's end: unread)
-        const __m256d k = _mm256_add_pd(_mm256_set1_pd(k0 + c), _mm256_setr_pd(0.0, 1.0, 2.0, 3.0));
-        const __m256d t = _mm256_mul_pd(k, step);
-        const __m256d x = _mm256_add_pd(_mm256_set1_pd(g.x0), _mm256_mul_pd(t, _mm256_set1_pd(g.sx)));
-        const __m256d y = _mm256_add_pd(_mm256_set1_pd(g.y0), _mm256_mul_pd(t, _mm256_set1_pd(g.sy)));
+[[gnu::target("avx2")]] FourLines four_lines(__m256d u, __m256d v, __m256d du, __m256d dv, __m128i width,
+                                             __m128i height, __m256d step, __m256d span, const Sampler& s) {
+    FourLines f;
+    f.width = width, f.height = height;
+    const __m128i sizes_minus_one = _mm_or_si128(_mm_and_si128(width, _mm_sub_epi32(width, _mm_set1_epi32(1))),
+                                                 _mm_and_si128(height, _mm_sub_epi32(height, _mm_set1_epi32(1))));
+    f.powers_of_two = _mm_testz_si128(sizes_minus_one, sizes_minus_one);
+    __m256d inside = _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), near = inside;
+    axis_lines(u, du, _mm256_cvtepi32_pd(width), step, span, s.wrap_u, f.x0, f.sx, inside, near);
+    axis_lines(v, dv, _mm256_cvtepi32_pd(height), step, span, s.wrap_v, f.y0, f.sy, inside, near);
+    f.inside = _mm256_movemask_pd(inside), f.near = _mm256_movemask_pd(near);
+    return f;
+}
+
+// Probes k0 … k0 + n − 1 of four lines: the quads' texels (indices into each line's level) and
+// fractions, [corner][probe][line]. Lines shorter than k0 + n get probes past their end (unread).
+struct FourProbes {
+    std::int32_t texel[4][kChunk][4];
+    float fx[kChunk][4], fy[kChunk][4];
+};
+
+[[gnu::target("avx2")]] void place_probes(const FourLines& f, __m256d step, int k0, int n, const Sampler& s,
+                                          FourProbes& p) {
+    const bool wraps = f.inside != 0b1111;  // (wrapping an index inside its level keeps it)
+    const __m128i one = _mm_set1_epi32(1);
+    for (int c = 0; c < n; ++c) {
+        const __m256d t = _mm256_mul_pd(_mm256_set1_pd(k0 + c), step);
+        const __m256d x = _mm256_add_pd(f.x0, _mm256_mul_pd(t, f.sx));
+        const __m256d y = _mm256_add_pd(f.y0, _mm256_mul_pd(t, f.sy));
         const __m256d fx = _mm256_floor_pd(x), fy = _mm256_floor_pd(y);
-        _mm_storeu_ps(p.fx + c, _mm256_cvtpd_ps(_mm256_sub_pd(x, fx)));
-        _mm_storeu_ps(p.fy + c, _mm256_cvtpd_ps(_mm256_sub_pd(y, fy)));
-        // Past the line's end a position may exceed the int range: the conversion gives INT_MIN there.
+        _mm_storeu_ps(p.fx[c], _mm256_cvtpd_ps(_mm256_sub_pd(x, fx)));
+        _mm_storeu_ps(p.fy[c], _mm256_cvtpd_ps(_mm256_sub_pd(y, fy)));
+        // A line past its end, or a lane the reference takes, may exceed the int range: the
+        // conversion gives INT_MIN there (its indices are not read).
         __m128i i0 = _mm256_cvttpd_epi32(fx), j0 = _mm256_cvttpd_epi32(fy);
-        const __m128i one = _mm_set1_epi32(1);
         __m128i i1 = _mm_add_epi32(i0, one), j1 = _mm_add_epi32(j0, one);
         if (wraps) {
-            i0 = wrap(i0, w, s.wrap_u), i1 = wrap(i1, w, s.wrap_u);
-            j0 = wrap(j0, h, s.wrap_v), j1 = wrap(j1, h, s.wrap_v);
+            i0 = wrap(i0, f.width, f.powers_of_two, s.wrap_u), i1 = wrap(i1, f.width, f.powers_of_two, s.wrap_u);
+            j0 = wrap(j0, f.height, f.powers_of_two, s.wrap_v), j1 = wrap(j1, f.height, f.powers_of_two, s.wrap_v);
         }
-        const __m128i width = _mm_set1_epi32(w);
-        const __m128i row0 = _mm_mullo_epi32(j0, width), row1 = _mm_mullo_epi32(j1, width);  // (wraps around, defined)
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[0] + c), _mm_add_epi32(row0, i0));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[1] + c), _mm_add_epi32(row0, i1));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[2] + c), _mm_add_epi32(row1, i0));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[3] + c), _mm_add_epi32(row1, i1));
+        const __m128i row0 = _mm_mullo_epi32(j0, f.width), row1 = _mm_mullo_epi32(j1, f.width);  // (wraps around, defined)
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[0][c]), _mm_add_epi32(row0, i0));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[1][c]), _mm_add_epi32(row0, i1));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[2][c]), _mm_add_epi32(row1, i0));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[3][c]), _mm_add_epi32(row1, i1));
     }
 }
 
-// Probe c's bilinear quad.
-[[gnu::target("avx2")]] inline Texel quad(const glm::vec4* t, const Probes& p, int c) {
-    return lerp_quad(load(t[p.texel[0][c]]), load(t[p.texel[1][c]]), load(t[p.texel[2][c]]), load(t[p.texel[3][c]]),
-                     p.fx[c], p.fy[c]);
+// Probe c's bilinear quad on line j.
+[[gnu::target("avx2")]] inline Texel quad(const glm::vec4* t, const FourProbes& p, int c, int j) {
+    return lerp_quad(load(t[p.texel[0][c][j]]), load(t[p.texel[1][c][j]]), load(t[p.texel[2][c][j]]),
+                     load(t[p.texel[3][c][j]]), p.fx[c][j], p.fy[c][j]);
 }
 
-[[gnu::target("avx2")]] Texel line_mean(const TextureLevel& level, const ProbeLine& g, int count, const Sampler& s) {
-    const glm::vec4* t = level.texels.data();
-    Probes p;
+// A line's running sum, as the reference adds its probes: the first quad, and the differences of
+// the others from it (so that a constant texture gives back its value exactly).
+struct LineSum {
     Texel first = splat(0.0f), difference = splat(0.0f);
-    for (int k0 = 0; k0 < count; k0 += kChunk) {
-        const int n = std::min(kChunk, count - k0);
-        place(g, k0, n, level.width, level.height, !g.inside, s, p);
-        int c = 0;
-        if (k0 == 0) first = quad(t, p, c++);
-        for (; c < n; ++c) difference += quad(t, p, c) - first;
-    }
-    return first + difference * splat(static_cast<float>(g.step));
+};
+
+// Adds probes k0 … end − 1 (placed from k0) of line j to `sum`.
+[[gnu::target("avx2")]] inline void add_probes(const glm::vec4* t, const FourProbes& p, int j, int k0, int end,
+                                               LineSum& sum) {
+    int k = k0;
+    if (k == 0) sum.first = quad(t, p, k++ - k0, j);
+    for (; k < end; ++k) sum.difference += quad(t, p, k - k0, j) - sum.first;
 }
 
-// line_mean on two levels at once: each sum in its own probe order (the same bits), the two
+// add_probes on two levels at once: each sum in its own probe order (the same bits), the two
 // chains of additions side by side so that they overlap.
-[[gnu::target("avx2")]] void line_means(const TextureLevel& a, const ProbeLine& ga, const TextureLevel& b,
-                                        const ProbeLine& gb, int count, const Sampler& s, Texel& mean_a,
-                                        Texel& mean_b) {
-    const glm::vec4 *ta = a.texels.data(), *tb = b.texels.data();
-    Probes pa, pb;
-    Texel first_a = splat(0.0f), difference_a = splat(0.0f), first_b = splat(0.0f), difference_b = splat(0.0f);
-    for (int k0 = 0; k0 < count; k0 += kChunk) {
-        const int n = std::min(kChunk, count - k0);
-        place(ga, k0, n, a.width, a.height, !ga.inside, s, pa);
-        place(gb, k0, n, b.width, b.height, !gb.inside, s, pb);
-        int c = 0;
-        if (k0 == 0) {
-            first_a = quad(ta, pa, 0);
-            first_b = quad(tb, pb, 0);
-            c = 1;
-        }
-        for (; c < n; ++c) {
-            difference_a += quad(ta, pa, c) - first_a;
-            difference_b += quad(tb, pb, c) - first_b;
+[[gnu::target("avx2")]] inline void add_probes(const glm::vec4* ta, const FourProbes& pa, const glm::vec4* tb,
+                                               const FourProbes& pb, int j, int k0, int end, LineSum& a, LineSum& b) {
+    int k = k0;
+    if (k == 0) {
+        a.first = quad(ta, pa, 0, j);
+        b.first = quad(tb, pb, 0, j);
+        ++k;
+    }
+    for (; k < end; ++k) {
+        a.difference += quad(ta, pa, k - k0, j) - a.first;
+        b.difference += quad(tb, pb, k - k0, j) - b.first;
+    }
+}
+
+// Whether the vectors take a line on `level` (else the reference does: too far out for int
+// indices, or a level whose texel indices overflow an int).
+bool vectors_reach(bool near, const TextureLevel& level) {
+    return near && level.texels.size() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+}
+
+// Lanes first … first + n − 1 (n ≤ 4) of `lanes`.
+[[gnu::target("avx2")]] void four_lanes(const LineLanes& lanes, int first, int n, const Sampler& s, Texel* mean_finer,
+                                        Texel* mean_coarser) {
+    alignas(32) double u[4] = {}, v[4] = {}, du[4] = {}, dv[4] = {}, count[4] = {1, 1, 1, 1};
+    alignas(16) std::int32_t width[2][4] = {{1, 1, 1, 1}, {1, 1, 1, 1}}, height[2][4] = {{1, 1, 1, 1}, {1, 1, 1, 1}};
+    bool two_levels = false;
+    for (int j = 0; j < n; ++j) {
+        const int i = first + j;
+        u[j] = lanes.u[i], v[j] = lanes.v[i], du[j] = lanes.du[i], dv[j] = lanes.dv[i], count[j] = lanes.count[i];
+        const TextureLevel* coarser = lanes.coarser[i] ? lanes.coarser[i] : lanes.finer[i];
+        width[0][j] = lanes.finer[i]->width, height[0][j] = lanes.finer[i]->height;
+        width[1][j] = coarser->width, height[1][j] = coarser->height;
+        two_levels |= lanes.coarser[i] != nullptr;
+    }
+    const __m256d counts = _mm256_load_pd(count);
+    const __m256d step = _mm256_div_pd(_mm256_set1_pd(1.0), counts);
+    const __m256d span = _mm256_mul_pd(_mm256_sub_pd(counts, _mm256_set1_pd(1.0)), step);
+    FourLines lines[2];
+    for (int k = 0; k < (two_levels ? 2 : 1); ++k)
+        lines[k] = four_lines(_mm256_load_pd(u), _mm256_load_pd(v), _mm256_load_pd(du), _mm256_load_pd(dv),
+                              _mm_load_si128(reinterpret_cast<const __m128i*>(width[k])),
+                              _mm_load_si128(reinterpret_cast<const __m128i*>(height[k])), step, span, s);
+
+    // The lanes the vectors take, and the longest of their lines.
+    int vector_lanes = 0, longest = 0;
+    for (int j = 0; j < n; ++j) {
+        const int i = first + j;
+        if (!vectors_reach(lines[0].near >> j & 1, *lanes.finer[i])) continue;
+        if (lanes.coarser[i] && !vectors_reach(lines[1].near >> j & 1, *lanes.coarser[i])) continue;
+        vector_lanes |= 1 << j;
+        longest = std::max(longest, lanes.count[first + j]);
+    }
+    LineSum sums[2][4];
+    FourProbes probes[2];
+    for (int k0 = 0; k0 < longest; k0 += kChunk) {
+        const int chunk = std::min(kChunk, longest - k0);
+        for (int k = 0; k < (two_levels ? 2 : 1); ++k) place_probes(lines[k], step, k0, chunk, s, probes[k]);
+        for (int j = 0; j < n; ++j) {
+            const int i = first + j, end = std::min(k0 + chunk, lanes.count[i]);
+            if (!(vector_lanes >> j & 1) || end <= k0) continue;
+            const glm::vec4* finer = lanes.finer[i]->texels.data();
+            if (lanes.coarser[i])
+                add_probes(finer, probes[0], lanes.coarser[i]->texels.data(), probes[1], j, k0, end, sums[0][j],
+                           sums[1][j]);
+            else
+                add_probes(finer, probes[0], j, k0, end, sums[0][j]);
         }
     }
-    mean_a = first_a + difference_a * splat(static_cast<float>(ga.step));
-    mean_b = first_b + difference_b * splat(static_cast<float>(gb.step));
-}
-
-// Whether line_mean takes g on `level` (else the reference does: too far out for int indices, or
-// a level whose texel indices overflow an int).
-bool vectors_reach(const ProbeLine& g, const TextureLevel& level) {
-    return g.near && level.texels.size() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
-}
-
-// The line g of the lookup (u, v, du, dv) on `level`: line_mean where it reaches, else the reference.
-[[gnu::target("avx2")]] Texel line_or_reference(const TextureLevel& level, const ProbeLine& g, const Sampler& s,
-                                                double u, double v, double du, double dv, int count) {
-    return vectors_reach(g, level) ? line_mean(level, g, count, s) : anisotropic_line(level, s, u, v, du, dv, count);
-}
-
-// probe_line on two levels at once, for repeat and clamp (the samplers BatchSampler covers, as
-// wrap() above): [x on a, x on b, y on a, y on b] in one vector, each element the same double
-// arithmetic as probe_line's (its std::min and std::max as selects), the wrap's division four at
-// a time instead of one per level and axis.
-[[gnu::target("avx2")]] void probe_lines(const TextureLevel& a, const TextureLevel& b, const Sampler& s, double u,
-                                         double v, double du, double dv, int count, ProbeLine& ga, ProbeLine& gb) {
-    const __m256d size = _mm256_setr_pd(a.width, b.width, a.height, b.height);
-    const __m256d x = _mm256_mul_pd(_mm256_setr_pd(u, u, v, v), size);
-    const __m256d repeats = _mm256_castsi256_pd(_mm256_setr_epi64x(-(s.wrap_u == WrapMode::repeat),
-                                                                   -(s.wrap_u == WrapMode::repeat),
-                                                                   -(s.wrap_v == WrapMode::repeat),
-                                                                   -(s.wrap_v == WrapMode::repeat)));
-    // reduce(): a coordinate inside [0, n) stays; one outside moves by whole periods, x − n·⌊x/n⌋.
-    const __m256d inside_range = _mm256_and_pd(_mm256_cmp_pd(x, _mm256_setzero_pd(), _CMP_GE_OQ),
-                                               _mm256_cmp_pd(x, size, _CMP_LT_OQ));
-    const __m256d periods = _mm256_round_pd(_mm256_div_pd(x, size), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
-    const __m256d reduced = _mm256_sub_pd(x, _mm256_mul_pd(size, periods));
-    const __m256d centre = _mm256_blendv_pd(x, reduced, _mm256_andnot_pd(inside_range, repeats));
-    const double step = 1.0 / count;
-    const __m256d slope = _mm256_mul_pd(_mm256_setr_pd(du, du, dv, dv), size);
-    const __m256d first = _mm256_add_pd(_mm256_sub_pd(centre, _mm256_set1_pd(0.5)),
-                                        _mm256_mul_pd(_mm256_set1_pd(0.5 * step - 0.5), slope));
-    const __m256d last = _mm256_add_pd(first, _mm256_mul_pd(_mm256_set1_pd((count - 1) * step), slope));
-    const __m256d lo = _mm256_blendv_pd(first, last, _mm256_cmp_pd(last, first, _CMP_LT_OQ));   // std::min
-    const __m256d hi = _mm256_blendv_pd(first, last, _mm256_cmp_pd(first, last, _CMP_LT_OQ));   // std::max
-    const __m256d last_texel = _mm256_sub_pd(size, _mm256_set1_pd(1.0));
-    const int inside = _mm256_movemask_pd(_mm256_and_pd(_mm256_cmp_pd(lo, _mm256_setzero_pd(), _CMP_GE_OQ),
-                                                        _mm256_cmp_pd(hi, last_texel, _CMP_LT_OQ)));
-    const __m256d reach = _mm256_set1_pd(kProbeReach);
-    const int near = _mm256_movemask_pd(_mm256_and_pd(_mm256_cmp_pd(lo, _mm256_sub_pd(_mm256_setzero_pd(), reach),
-                                                                    _CMP_GT_OQ),
-                                                      _mm256_cmp_pd(hi, reach, _CMP_LT_OQ)));
-    alignas(32) double x0[4], sx[4];
-    _mm256_store_pd(x0, first);
-    _mm256_store_pd(sx, slope);
-    ga = {x0[0], x0[2], sx[0], sx[2], step, (inside & 0b0101) == 0b0101, (near & 0b0101) == 0b0101};
-    gb = {x0[1], x0[3], sx[1], sx[3], step, (inside & 0b1010) == 0b1010, (near & 0b1010) == 0b1010};
+    alignas(32) double steps[4];
+    _mm256_store_pd(steps, step);
+    for (int j = 0; j < n; ++j) {
+        const int i = first + j;
+        const auto mean = [&](const LineSum& sum) { return sum.first + sum.difference * splat(static_cast<float>(steps[j])); };
+        const auto reference = [&](const TextureLevel& level) {
+            return anisotropic_line(level, s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
+        };
+        const bool vectors = vector_lanes >> j & 1;
+        mean_finer[i] = vectors ? mean(sums[0][j]) : reference(*lanes.finer[i]);
+        if (lanes.coarser[i]) mean_coarser[i] = vectors ? mean(sums[1][j]) : reference(*lanes.coarser[i]);
+    }
 }
 
 }  // namespace
 
-[[gnu::target("avx2")]] Texel anisotropic_line_avx2(const TextureLevel& level, const Sampler& s, double u, double v,
-                                                     double du, double dv, int count) {
-    return line_or_reference(level, probe_line(level, s, u, v, du, dv, count), s, u, v, du, dv, count);
-}
-
-[[gnu::target("avx2")]] void anisotropic_lines_avx2(const TextureLevel& a, const TextureLevel& b, const Sampler& s,
-                                                    double u, double v, double du, double dv, int count, Texel& mean_a,
-                                                    Texel& mean_b) {
-    ProbeLine ga, gb;
-    probe_lines(a, b, s, u, v, du, dv, count, ga, gb);
-    if (vectors_reach(ga, a) && vectors_reach(gb, b)) return line_means(a, ga, b, gb, count, s, mean_a, mean_b);
-    mean_a = line_or_reference(a, ga, s, u, v, du, dv, count);  // (the lines already placed, not again)
-    mean_b = line_or_reference(b, gb, s, u, v, du, dv, count);
+[[gnu::target("avx2")]] void anisotropic_line_means_avx2(const LineLanes& lanes, const Sampler& s, Texel* mean_finer,
+                                                         Texel* mean_coarser) {
+    for (int first = 0; first < lanes.n; first += 4)
+        four_lanes(lanes, first, std::min(4, lanes.n - first), s, mean_finer, mean_coarser);
 }
 
 #else  // (other CPUs never call it: BatchSampler uses it only where AVX2 is)
 
-Texel anisotropic_line_avx2(const TextureLevel& level, const Sampler& s, double u, double v, double du, double dv,
-                            int count) {
-    return anisotropic_line(level, s, u, v, du, dv, count);
-}
-
-void anisotropic_lines_avx2(const TextureLevel& a, const TextureLevel& b, const Sampler& s, double u, double v,
-                            double du, double dv, int count, Texel& mean_a, Texel& mean_b) {
-    mean_a = anisotropic_line(a, s, u, v, du, dv, count);
-    mean_b = anisotropic_line(b, s, u, v, du, dv, count);
+void anisotropic_line_means_avx2(const LineLanes& lanes, const Sampler& s, Texel* mean_finer, Texel* mean_coarser) {
+    for (int i = 0; i < lanes.n; ++i) {
+        mean_finer[i] = anisotropic_line(*lanes.finer[i], s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
+        if (lanes.coarser[i])
+            mean_coarser[i] =
+                anisotropic_line(*lanes.coarser[i], s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
+    }
 }
 
 #endif

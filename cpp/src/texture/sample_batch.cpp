@@ -450,7 +450,6 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     std::fill(lines.rho2_scale, lines.rho2_scale + kLookupBatch, 1.0f);
     const bool some_lines = s.footprint == FootprintFilter::anisotropic &&
                             probe_lines(b, n, texture_.width(), texture_.height(), levels, s, lines);
-    const auto line_mean = vector_width_ == 8 ? anisotropic_line_avx2 : anisotropic_line;
     LanePlan plan;
     (vector_width_ == 8 ? plan_avx2 : plan_sse2)(b, lines.rho2_scale, n, s, texture_.width(), texture_.height(), levels,
                                                  plan);
@@ -468,26 +467,44 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
             __builtin_prefetch(t + plan.texel[0][2][l]);
         }
     }
+    // With AVX2, the lines of all the batch's lanes that take them at once (index line_of[l]).
+    const bool batched_lines = some_lines && vector_width_ == 8;
+    LineLanes line_lanes;
+    int line_of[kLookupBatch];
+    Texel finer_means[kLookupBatch], coarser_means[kLookupBatch];
+    if (batched_lines) {
+        for (int l = 0; l < n; ++l) {
+            if (!plan.finite[l] || lines.count[l] == 1) continue;
+            const int i = line_lanes.n++;
+            line_of[l] = i;
+            line_lanes.u[i] = b.u[l], line_lanes.v[i] = b.v[l];
+            line_lanes.du[i] = lines.along_x[l] ? b.dudx[l] : b.dudy[l];
+            line_lanes.dv[i] = lines.along_x[l] ? b.dvdx[l] : b.dvdy[l];
+            line_lanes.count[i] = lines.count[l];
+            line_lanes.finer[i] = &texture_.level(plan.level[l]);
+            line_lanes.coarser[i] = plan.level_weight[l] > 0.0f ? &texture_.level(plan.level[l] + 1) : nullptr;
+        }
+        anisotropic_line_means_avx2(line_lanes, s, finer_means, coarser_means);
+    }
     for (int l = 0; l < n; ++l) {
         if (!plan.finite[l]) {
             out[l] = sample_texture(texture_, s, {b.u[l], b.v[l]}, {b.dudx[l], b.dvdx[l]}, {b.dudy[l], b.dvdy[l]});
             continue;
         }
         if (some_lines && lines.count[l] > 1) {  // the reference's line of probes, on the plan's level(s)
-            const double du = lines.along_x[l] ? b.dudx[l] : b.dudy[l], dv = lines.along_x[l] ? b.dvdx[l] : b.dvdy[l];
-            const auto line = [&](int k) {
-                return line_mean(texture_.level(k), s, b.u[l], b.v[l], du, dv, lines.count[l]);
-            };
-            const int fine = plan.level[l];
             Texel c;
-            if (plan.level_weight[l] > 0.0f && vector_width_ == 8) {  // both levels' lines side by side
-                Texel finer, coarser;
-                anisotropic_lines_avx2(texture_.level(fine), texture_.level(fine + 1), s, b.u[l], b.v[l], du, dv,
-                                       lines.count[l], finer, coarser);
-                c = lerp(finer, coarser, plan.level_weight[l]);
+            if (batched_lines) {
+                const int i = line_of[l];
+                c = plan.level_weight[l] > 0.0f ? lerp(finer_means[i], coarser_means[i], plan.level_weight[l])
+                                                : finer_means[i];
             } else {
-                c = line(fine);
-                if (plan.level_weight[l] > 0.0f) c = lerp(c, line(fine + 1), plan.level_weight[l]);
+                const double du = lines.along_x[l] ? b.dudx[l] : b.dudy[l];
+                const double dv = lines.along_x[l] ? b.dvdx[l] : b.dvdy[l];
+                const auto line = [&](int k) {
+                    return anisotropic_line(texture_.level(k), s, b.u[l], b.v[l], du, dv, lines.count[l]);
+                };
+                c = line(plan.level[l]);
+                if (plan.level_weight[l] > 0.0f) c = lerp(c, line(plan.level[l] + 1), plan.level_weight[l]);
             }
             out[l] = to_vec4(c);
             continue;
