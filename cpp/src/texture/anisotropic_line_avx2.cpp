@@ -107,10 +107,14 @@ struct FourProbes {
     float fx[kChunk][4], fy[kChunk][4];
 };
 
-[[gnu::target("avx2")]] void place_probes(const FourLines& f, __m256d step, int k0, int n, const Sampler& s,
+// `used`: bit j where line j's probes are read. Where all of those lie inside their levels, a
+// quad's first texel is ⌊y⌋·width + ⌊x⌋ in double (exact: below the level's texel count, which
+// fits an int) and the others follow by adding; else the indices wrap.
+[[gnu::target("avx2")]] void place_probes(const FourLines& f, int used, __m256d step, int k0, int n, const Sampler& s,
                                           FourProbes& p) {
-    const bool wraps = f.inside != 0b1111;  // (wrapping an index inside its level keeps it)
-    const __m128i one = _mm_set1_epi32(1);
+    const bool wraps = (f.inside & used) != used;
+    const __m256d width = _mm256_cvtepi32_pd(f.width);
+    const __m128i one = _mm_set1_epi32(1), below = _mm_add_epi32(f.width, one);
     for (int c = 0; c < n; ++c) {
         const __m256d t = _mm256_mul_pd(_mm256_set1_pd(k0 + c), step);
         const __m256d x = _mm256_add_pd(f.x0, _mm256_mul_pd(t, f.sx));
@@ -118,19 +122,26 @@ struct FourProbes {
         const __m256d fx = _mm256_floor_pd(x), fy = _mm256_floor_pd(y);
         _mm_storeu_ps(p.fx[c], _mm256_cvtpd_ps(_mm256_sub_pd(x, fx)));
         _mm_storeu_ps(p.fy[c], _mm256_cvtpd_ps(_mm256_sub_pd(y, fy)));
-        // A line past its end, or a lane the reference takes, may exceed the int range: the
-        // conversion gives INT_MIN there (its indices are not read).
-        __m128i i0 = _mm256_cvttpd_epi32(fx), j0 = _mm256_cvttpd_epi32(fy);
-        __m128i i1 = _mm_add_epi32(i0, one), j1 = _mm_add_epi32(j0, one);
-        if (wraps) {
-            i0 = wrap(i0, f.width, f.powers_of_two, s.wrap_u), i1 = wrap(i1, f.width, f.powers_of_two, s.wrap_u);
-            j0 = wrap(j0, f.height, f.powers_of_two, s.wrap_v), j1 = wrap(j1, f.height, f.powers_of_two, s.wrap_v);
+        // Past a line's end, or on a line the reference takes, a value may exceed the int range:
+        // the conversion gives INT_MIN there (and the sums below wrap around, defined; unread).
+        __m128i texel[4];
+        if (!wraps) {
+            texel[0] = _mm256_cvttpd_epi32(_mm256_add_pd(_mm256_mul_pd(fy, width), fx));
+            texel[1] = _mm_add_epi32(texel[0], one);
+            texel[2] = _mm_add_epi32(texel[0], f.width);
+            texel[3] = _mm_add_epi32(texel[0], below);
+        } else {
+            const __m128i i0 = _mm256_cvttpd_epi32(fx), j0 = _mm256_cvttpd_epi32(fy);
+            const __m128i i1 = wrap(_mm_add_epi32(i0, one), f.width, f.powers_of_two, s.wrap_u);
+            const __m128i j1 = wrap(_mm_add_epi32(j0, one), f.height, f.powers_of_two, s.wrap_v);
+            const __m128i i = wrap(i0, f.width, f.powers_of_two, s.wrap_u);
+            const __m128i row0 = _mm_mullo_epi32(wrap(j0, f.height, f.powers_of_two, s.wrap_v), f.width);
+            const __m128i row1 = _mm_mullo_epi32(j1, f.width);
+            texel[0] = _mm_add_epi32(row0, i), texel[1] = _mm_add_epi32(row0, i1);
+            texel[2] = _mm_add_epi32(row1, i), texel[3] = _mm_add_epi32(row1, i1);
         }
-        const __m128i row0 = _mm_mullo_epi32(j0, f.width), row1 = _mm_mullo_epi32(j1, f.width);  // (wraps around, defined)
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[0][c]), _mm_add_epi32(row0, i0));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[1][c]), _mm_add_epi32(row0, i1));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[2][c]), _mm_add_epi32(row1, i0));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[3][c]), _mm_add_epi32(row1, i1));
+        for (int corner = 0; corner < 4; ++corner)
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[corner][c]), texel[corner]);
     }
 }
 
@@ -212,7 +223,8 @@ bool vectors_reach(bool near, const TextureLevel& level) {
     FourProbes probes[2];
     for (int k0 = 0; k0 < longest; k0 += kChunk) {
         const int chunk = std::min(kChunk, longest - k0);
-        for (int k = 0; k < (two_levels ? 2 : 1); ++k) place_probes(lines[k], step, k0, chunk, s, probes[k]);
+        for (int k = 0; k < (two_levels ? 2 : 1); ++k)
+            place_probes(lines[k], vector_lanes, step, k0, chunk, s, probes[k]);
         for (int j = 0; j < n; ++j) {
             const int i = first + j, end = std::min(k0 + chunk, lanes.count[i]);
             if (!(vector_lanes >> j & 1) || end <= k0) continue;
