@@ -190,25 +190,31 @@ bool vectors_reach(bool near, const TextureLevel& level) {
 // Lanes first … first + n − 1 (n ≤ 4) of `lanes`.
 [[gnu::target("avx2")]] void four_lanes(const LineLanes& lanes, int first, int n, const Sampler& s, Texel* mean_finer,
                                         Texel* mean_coarser) {
-    alignas(32) double u[4] = {}, v[4] = {}, du[4] = {}, dv[4] = {}, count[4] = {1, 1, 1, 1};
-    alignas(16) std::int32_t width[2][4] = {{1, 1, 1, 1}, {1, 1, 1, 1}}, height[2][4] = {{1, 1, 1, 1}, {1, 1, 1, 1}};
-    bool two_levels = false;
-    for (int j = 0; j < n; ++j) {
-        const int i = first + j;
-        u[j] = lanes.u[i], v[j] = lanes.v[i], du[j] = lanes.du[i], dv[j] = lanes.dv[i], count[j] = lanes.count[i];
-        const TextureLevel* coarser = lanes.coarser[i] ? lanes.coarser[i] : lanes.finer[i];
-        width[0][j] = lanes.finer[i]->width, height[0][j] = lanes.finer[i]->height;
-        width[1][j] = coarser->width, height[1][j] = coarser->height;
-        two_levels |= lanes.coarser[i] != nullptr;
-    }
-    const __m256d counts = _mm256_load_pd(count);
+    // The inputs straight from the caller's arrays (lanes past n as zeros; their counts as 1): a
+    // vector loaded from scalars just stored waits for them to reach the cache.
+    const __m256i used = _mm256_cmpgt_epi64(_mm256_set1_epi64x(n), _mm256_setr_epi64x(0, 1, 2, 3));
+    const __m128i used_ints = _mm_cmpgt_epi32(_mm_set1_epi32(n), _mm_setr_epi32(0, 1, 2, 3));
+    const __m128i count = _mm_blendv_epi8(_mm_set1_epi32(1), _mm_maskload_epi32(lanes.count + first, used_ints), used_ints);
+    const __m256d counts = _mm256_cvtepi32_pd(count);
     const __m256d step = _mm256_div_pd(_mm256_set1_pd(1.0), counts);
     const __m256d span = _mm256_mul_pd(_mm256_sub_pd(counts, _mm256_set1_pd(1.0)), step);
+    bool two_levels = false;
+    for (int j = 0; j < n; ++j) two_levels |= lanes.coarser[first + j] != nullptr;
     FourLines lines[2];
-    for (int k = 0; k < (two_levels ? 2 : 1); ++k)
-        lines[k] = four_lines(_mm256_load_pd(u), _mm256_load_pd(v), _mm256_load_pd(du), _mm256_load_pd(dv),
-                              _mm_load_si128(reinterpret_cast<const __m128i*>(width[k])),
-                              _mm_load_si128(reinterpret_cast<const __m128i*>(height[k])), step, span, s);
+    for (int k = 0; k < (two_levels ? 2 : 1); ++k) {
+        const auto level = [&](int j) -> const TextureLevel* {
+            if (j >= n) return nullptr;
+            return k == 1 && lanes.coarser[first + j] ? lanes.coarser[first + j] : lanes.finer[first + j];
+        };
+        const TextureLevel* four[4] = {level(0), level(1), level(2), level(3)};
+        const auto size = [&](int TextureLevel::*dimension) {
+            const auto of = [&](int j) { return four[j] ? four[j]->*dimension : 1; };
+            return _mm_setr_epi32(of(0), of(1), of(2), of(3));
+        };
+        lines[k] = four_lines(_mm256_maskload_pd(lanes.u + first, used), _mm256_maskload_pd(lanes.v + first, used),
+                              _mm256_maskload_pd(lanes.du + first, used), _mm256_maskload_pd(lanes.dv + first, used),
+                              size(&TextureLevel::width), size(&TextureLevel::height), step, span, s);
+    }
 
     // The lanes the vectors take, and the longest of their lines.
     int vector_lanes = 0, longest = 0;
