@@ -66,12 +66,14 @@ constexpr int kChunk = 16;  // probes of each line placed at a time
     }
     slope = _mm256_mul_pd(d, size);
     const __m256d half = _mm256_set1_pd(0.5);
-    first = _mm256_add_pd(_mm256_sub_pd(first, half), _mm256_mul_pd(_mm256_sub_pd(_mm256_mul_pd(half, step), half), slope));
+    const __m256d back = _mm256_sub_pd(_mm256_mul_pd(half, step), half);  // (½·step − ½): probe 0's offset
+    first = _mm256_add_pd(_mm256_sub_pd(first, half), _mm256_mul_pd(back, slope));
     const __m256d last = _mm256_add_pd(first, _mm256_mul_pd(span, slope));
     const __m256d lo = _mm256_blendv_pd(first, last, _mm256_cmp_pd(last, first, _CMP_LT_OQ));  // std::min
     const __m256d hi = _mm256_blendv_pd(first, last, _mm256_cmp_pd(first, last, _CMP_LT_OQ));  // std::max
+    const __m256d last_texel = _mm256_sub_pd(size, _mm256_set1_pd(1.0));
     inside = _mm256_and_pd(inside, _mm256_and_pd(_mm256_cmp_pd(lo, _mm256_setzero_pd(), _CMP_GE_OQ),
-                                                 _mm256_cmp_pd(hi, _mm256_sub_pd(size, _mm256_set1_pd(1.0)), _CMP_LT_OQ)));
+                                                 _mm256_cmp_pd(hi, last_texel, _CMP_LT_OQ)));
     const __m256d reach = _mm256_set1_pd(kProbeReach);
     near = _mm256_and_pd(near, _mm256_and_pd(_mm256_cmp_pd(lo, _mm256_sub_pd(_mm256_setzero_pd(), reach), _CMP_GT_OQ),
                                              _mm256_cmp_pd(hi, reach, _CMP_LT_OQ)));
@@ -114,7 +116,7 @@ struct FourProbes {
                                           FourProbes& p) {
     const bool wraps = (f.inside & used) != used;
     const __m256d width = _mm256_cvtepi32_pd(f.width);
-    const __m128i one = _mm_set1_epi32(1), below = _mm_add_epi32(f.width, one);
+    const __m128i one = _mm_set1_epi32(1), below_right = _mm_add_epi32(f.width, one);
     for (int c = 0; c < n; ++c) {
         const __m256d t = _mm256_mul_pd(_mm256_set1_pd(k0 + c), step);
         const __m256d x = _mm256_add_pd(f.x0, _mm256_mul_pd(t, f.sx));
@@ -129,7 +131,7 @@ struct FourProbes {
             texel[0] = _mm256_cvttpd_epi32(_mm256_add_pd(_mm256_mul_pd(fy, width), fx));
             texel[1] = _mm_add_epi32(texel[0], one);
             texel[2] = _mm_add_epi32(texel[0], f.width);
-            texel[3] = _mm_add_epi32(texel[0], below);
+            texel[3] = _mm_add_epi32(texel[0], below_right);
         } else {
             const __m128i i0 = _mm256_cvttpd_epi32(fx), j0 = _mm256_cvttpd_epi32(fy);
             const __m128i i1 = wrap(_mm_add_epi32(i0, one), f.width, f.powers_of_two, s.wrap_u);
@@ -161,7 +163,10 @@ struct LineSum {
 [[gnu::target("avx2")]] inline void add_probes(const glm::vec4* t, const FourProbes& p, int j, int k0, int end,
                                                LineSum& sum) {
     int k = k0;
-    if (k == 0) sum.first = quad(t, p, k++ - k0, j);
+    if (k == 0) {
+        sum.first = quad(t, p, 0, j);
+        ++k;
+    }
     for (; k < end; ++k) sum.difference += quad(t, p, k - k0, j) - sum.first;
 }
 
@@ -194,7 +199,8 @@ bool vectors_reach(bool near, const TextureLevel& level) {
     // vector loaded from scalars just stored waits for them to reach the cache.
     const __m256i used = _mm256_cmpgt_epi64(_mm256_set1_epi64x(n), _mm256_setr_epi64x(0, 1, 2, 3));
     const __m128i used_ints = _mm_cmpgt_epi32(_mm_set1_epi32(n), _mm_setr_epi32(0, 1, 2, 3));
-    const __m128i count = _mm_blendv_epi8(_mm_set1_epi32(1), _mm_maskload_epi32(lanes.count + first, used_ints), used_ints);
+    const __m128i count =
+        _mm_blendv_epi8(_mm_set1_epi32(1), _mm_maskload_epi32(lanes.count + first, used_ints), used_ints);
     const __m256d counts = _mm256_cvtepi32_pd(count);
     const __m256d step = _mm256_div_pd(_mm256_set1_pd(1.0), counts);
     const __m256d span = _mm256_mul_pd(_mm256_sub_pd(counts, _mm256_set1_pd(1.0)), step);
@@ -223,7 +229,7 @@ bool vectors_reach(bool near, const TextureLevel& level) {
         if (!vectors_reach(lines[0].near >> j & 1, *lanes.finer[i])) continue;
         if (lanes.coarser[i] && !vectors_reach(lines[1].near >> j & 1, *lanes.coarser[i])) continue;
         vector_lanes |= 1 << j;
-        longest = std::max(longest, lanes.count[first + j]);
+        longest = std::max(longest, lanes.count[i]);
     }
     LineSum sums[2][4];
     FourProbes probes[2];
@@ -246,7 +252,9 @@ bool vectors_reach(bool near, const TextureLevel& level) {
     _mm256_store_pd(steps, step);
     for (int j = 0; j < n; ++j) {
         const int i = first + j;
-        const auto mean = [&](const LineSum& sum) { return sum.first + sum.difference * splat(static_cast<float>(steps[j])); };
+        const auto mean = [&](const LineSum& sum) {
+            return sum.first + sum.difference * splat(static_cast<float>(steps[j]));
+        };
         const auto reference = [&](const TextureLevel& level) {
             return anisotropic_line(level, s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
         };
@@ -268,10 +276,11 @@ bool vectors_reach(bool near, const TextureLevel& level) {
 
 void anisotropic_line_means_avx2(const LineLanes& lanes, const Sampler& s, Texel* mean_finer, Texel* mean_coarser) {
     for (int i = 0; i < lanes.n; ++i) {
-        mean_finer[i] = anisotropic_line(*lanes.finer[i], s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
-        if (lanes.coarser[i])
-            mean_coarser[i] =
-                anisotropic_line(*lanes.coarser[i], s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
+        const auto line = [&](const TextureLevel& level) {
+            return anisotropic_line(level, s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
+        };
+        mean_finer[i] = line(*lanes.finer[i]);
+        if (lanes.coarser[i]) mean_coarser[i] = line(*lanes.coarser[i]);
     }
 }
 
