@@ -263,31 +263,34 @@ template <int W, bool kPowerOfTwo>
 // are two (or four) independent chains of arithmetic, which the CPU overlaps: a batch of eight
 // left the planner waiting on one chain's latency. With AVX2 both halves' levels come first, so
 // that their λ chains (a division and a polynomial) are near enough in the code to overlap.
-void plan_sse2(const LookupBatch& b, const float* rho2_scale, int count, const Sampler& s, int width, int height,
-               int levels, LanePlan& plan) {
-    for (int first = 0; first < count; first += 4)
-        plan_quads<4, false>(plan_levels<4>(b, rho2_scale, first, s, width, height, levels, plan), first, s, width,
-                             height, levels, plan);
+// Without `quads`, only the levels (a batch whose lanes all take lines of probes).
+void plan_sse2(const LookupBatch& b, const float* rho2_scale, int count, bool quads, const Sampler& s, int width,
+               int height, int levels, LanePlan& plan) {
+    for (int first = 0; first < count; first += 4) {
+        const LaneLevels<4> lanes = plan_levels<4>(b, rho2_scale, first, s, width, height, levels, plan);
+        if (quads) plan_quads<4, false>(lanes, first, s, width, height, levels, plan);
+    }
 }
 #if defined(__x86_64__)
 template <bool kPowerOfTwo>
-[[gnu::always_inline]] inline void plan_eight(const LookupBatch& b, const float* rho2_scale, const Sampler& s, int width,
-                                              int height, int levels, LanePlan& plan) {
+[[gnu::always_inline]] inline void plan_eight(const LookupBatch& b, const float* rho2_scale, bool quads,
+                                              const Sampler& s, int width, int height, int levels, LanePlan& plan) {
     const LaneLevels<8> low = plan_levels<8>(b, rho2_scale, 0, s, width, height, levels, plan);
     const LaneLevels<8> high = plan_levels<8>(b, rho2_scale, 8, s, width, height, levels, plan);
+    if (!quads) return;
     plan_quads<8, kPowerOfTwo>(low, 0, s, width, height, levels, plan);
     plan_quads<8, kPowerOfTwo>(high, 8, s, width, height, levels, plan);
 }
-[[gnu::target("avx2")]] void plan_avx2(const LookupBatch& b, const float* rho2_scale, int, const Sampler& s, int width,
-                                      int height, int levels, LanePlan& plan) {
+[[gnu::target("avx2")]] void plan_avx2(const LookupBatch& b, const float* rho2_scale, int, bool quads, const Sampler& s,
+                                      int width, int height, int levels, LanePlan& plan) {
     const bool powers_of_two = (width & (width - 1)) == 0 && (height & (height - 1)) == 0;
-    if (powers_of_two) plan_eight<true>(b, rho2_scale, s, width, height, levels, plan);
-    else plan_eight<false>(b, rho2_scale, s, width, height, levels, plan);
+    if (powers_of_two) plan_eight<true>(b, rho2_scale, quads, s, width, height, levels, plan);
+    else plan_eight<false>(b, rho2_scale, quads, s, width, height, levels, plan);
 }
 #else  // (other CPUs: the four-lane path; never called)
-void plan_avx2(const LookupBatch& b, const float* rho2_scale, int count, const Sampler& s, int width, int height,
-               int levels, LanePlan& plan) {
-    plan_sse2(b, rho2_scale, count, s, width, height, levels, plan);
+void plan_avx2(const LookupBatch& b, const float* rho2_scale, int count, bool quads, const Sampler& s, int width,
+               int height, int levels, LanePlan& plan) {
+    plan_sse2(b, rho2_scale, count, quads, s, width, height, levels, plan);
 }
 #endif
 
@@ -450,15 +453,18 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     std::fill(lines.rho2_scale, lines.rho2_scale + kLookupBatch, 1.0f);
     const bool some_lines = s.footprint == FootprintFilter::anisotropic &&
                             probe_lines(b, n, texture_.width(), texture_.height(), levels, s, lines);
+    // A batch whose lanes all take lines (a surface at a grazing angle) reads no quad of the plan.
+    bool only_lines = some_lines;
+    for (int l = 0; l < n && only_lines; ++l) only_lines = lines.count[l] > 1;
     LanePlan plan;
-    (vector_width_ == 8 ? plan_avx2 : plan_sse2)(b, lines.rho2_scale, n, s, texture_.width(), texture_.height(), levels,
-                                                 plan);
+    (vector_width_ == 8 ? plan_avx2 : plan_sse2)(b, lines.rho2_scale, n, !only_lines, s, texture_.width(),
+                                                 texture_.height(), levels, plan);
     // Lanes spread over more than one row of texels (a surface whose texture runs across the
     // screen's rows) read texels the hardware prefetcher cannot foresee: the rows of all quads on
     // the finer level are asked for first, so that the misses overlap instead of each lane
     // waiting for its own. (The coarser level has a quarter of the lines, mostly in cache; asking
     // for them too, or on four rows' spread only, saved less in the cube.)
-    if (n > 1 && std::abs(std::int64_t{plan.texel[0][0][n - 1]} - plan.texel[0][0][0]) >
+    if (!only_lines && n > 1 && std::abs(std::int64_t{plan.texel[0][0][n - 1]} - plan.texel[0][0][0]) >
                      std::max(1, texture_.width() >> plan.level[0])) {
         for (int l = 0; l < n; ++l) {
             if (!plan.finite[l] || (some_lines && lines.count[l] > 1)) continue;
