@@ -44,10 +44,14 @@ struct LineLanes {
     const TextureLevel* coarser[kLookupBatch];
 };
 
-/// anisotropic_line's bits with AVX2 (anisotropic_line_avx2.cpp), for repeat and clamp, for every
-/// lane i < lanes.n: mean_finer[i] on *finer[i] and, where coarser[i] is not null, mean_coarser[i]
-/// on *coarser[i]. The lines are placed four lanes per vector and their probes four per vector;
-/// a lookup's two lines are summed side by side. Only on a CPU with AVX2.
+/// anisotropic_line for every lane i < lanes.n: mean_finer[i] on *finer[i] and, where coarser[i]
+/// is not null, mean_coarser[i] on *coarser[i] (one lane at a time: the four-lane batch path's).
+void anisotropic_line_means(const LineLanes& lanes, const Sampler& sampler, texel::Texel* mean_finer,
+                            texel::Texel* mean_coarser);
+
+/// anisotropic_line_means' bits with AVX2 (anisotropic_line_avx2.cpp), for repeat and clamp: the
+/// lines placed four lanes per vector, probe k of four lines in one vector, a lookup's two lines
+/// summed side by side. Only on a CPU with AVX2.
 void anisotropic_line_means_avx2(const LineLanes& lanes, const Sampler& sampler, texel::Texel* mean_finer,
                                  texel::Texel* mean_coarser);
 

@@ -275,13 +275,7 @@ bool vectors_reach(bool near, const TextureLevel& level) {
 #else  // (other CPUs never call it: BatchSampler uses it only where AVX2 is)
 
 void anisotropic_line_means_avx2(const LineLanes& lanes, const Sampler& s, Texel* mean_finer, Texel* mean_coarser) {
-    for (int i = 0; i < lanes.n; ++i) {
-        const auto line = [&](const TextureLevel& level) {
-            return anisotropic_line(level, s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
-        };
-        mean_finer[i] = line(*lanes.finer[i]);
-        if (lanes.coarser[i]) mean_coarser[i] = line(*lanes.coarser[i]);
-    }
+    anisotropic_line_means(lanes, s, mean_finer, mean_coarser);
 }
 
 #endif

@@ -378,6 +378,16 @@ Texel anisotropic_line(const TextureLevel& level, const Sampler& s, double u, do
     return probe_mean<TexelFilter::linear>(p, u, v, level, s);
 }
 
+void anisotropic_line_means(const LineLanes& lanes, const Sampler& s, Texel* mean_finer, Texel* mean_coarser) {
+    for (int i = 0; i < lanes.n; ++i) {
+        const auto line = [&](const TextureLevel& level) {
+            return anisotropic_line(level, s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
+        };
+        mean_finer[i] = line(*lanes.finer[i]);
+        if (lanes.coarser[i]) mean_coarser[i] = line(*lanes.coarser[i]);
+    }
+}
+
 namespace {
 
 Texel anisotropic(const TextureView& t, double u, double v, const Footprint& f, glm::vec2 dx, glm::vec2 dy,

@@ -473,12 +473,11 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
             __builtin_prefetch(t + plan.texel[0][2][l]);
         }
     }
-    // With AVX2, the lines of all the batch's lanes that take them at once (index line_of[l]).
-    const bool batched_lines = some_lines && vector_width_ == 8;
+    // The lines of all the batch's lanes that take them, at once (lane l's is line_of[l]).
     LineLanes line_lanes;
     int line_of[kLookupBatch];
     Texel finer_means[kLookupBatch], coarser_means[kLookupBatch];
-    if (batched_lines) {
+    if (some_lines) {
         for (int l = 0; l < n; ++l) {
             if (!plan.finite[l] || lines.count[l] == 1) continue;
             const int i = line_lanes.n++;
@@ -490,7 +489,8 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
             line_lanes.finer[i] = &texture_.level(plan.level[l]);
             line_lanes.coarser[i] = plan.level_weight[l] > 0.0f ? &texture_.level(plan.level[l] + 1) : nullptr;
         }
-        anisotropic_line_means_avx2(line_lanes, s, finer_means, coarser_means);
+        (vector_width_ == 8 ? anisotropic_line_means_avx2 : anisotropic_line_means)(line_lanes, s, finer_means,
+                                                                                     coarser_means);
     }
     for (int l = 0; l < n; ++l) {
         if (!plan.finite[l]) {
@@ -498,21 +498,9 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
             continue;
         }
         if (some_lines && lines.count[l] > 1) {  // the reference's line of probes, on the plan's level(s)
-            Texel c;
-            if (batched_lines) {
-                const int i = line_of[l];
-                c = plan.level_weight[l] > 0.0f ? lerp(finer_means[i], coarser_means[i], plan.level_weight[l])
-                                                : finer_means[i];
-            } else {
-                const double du = lines.along_x[l] ? b.dudx[l] : b.dudy[l];
-                const double dv = lines.along_x[l] ? b.dvdx[l] : b.dvdy[l];
-                const auto line = [&](int k) {
-                    return anisotropic_line(texture_.level(k), s, b.u[l], b.v[l], du, dv, lines.count[l]);
-                };
-                c = line(plan.level[l]);
-                if (plan.level_weight[l] > 0.0f) c = lerp(c, line(plan.level[l] + 1), plan.level_weight[l]);
-            }
-            out[l] = to_vec4(c);
+            const int i = line_of[l];
+            out[l] = to_vec4(plan.level_weight[l] > 0.0f ? lerp(finer_means[i], coarser_means[i], plan.level_weight[l])
+                                                         : finer_means[i]);
             continue;
         }
         const auto quad = [&](int step) {
