@@ -102,21 +102,21 @@ struct FourLines {
     return f;
 }
 
-// Probes k0 … k0 + n − 1 of four lines: the quads' texels (indices into each line's level) and
-// fractions, [corner][probe][line]. Lines shorter than k0 + n get probes past their end (unread).
+// Probes k0 … k0 + n − 1 of four lines: the quads' texels (indices into each line's level; only
+// corner 0 where the lines lie inside their levels) and fractions, [corner][probe][line]. Lines
+// shorter than k0 + n get probes past their end (unread).
 struct FourProbes {
     std::int32_t texel[4][kChunk][4];
     float fx[kChunk][4], fy[kChunk][4];
 };
 
-// `used`: bit j where line j's probes are read. Where all of those lie inside their levels, a
-// quad's first texel is ⌊y⌋·width + ⌊x⌋ in double (exact: below the level's texel count, which
-// fits an int) and the others follow by adding; else the indices wrap.
-[[gnu::target("avx2")]] void place_probes(const FourLines& f, int used, __m256d step, int k0, int n, const Sampler& s,
-                                          FourProbes& p) {
-    const bool wraps = (f.inside & used) != used;
+// `inside`: the lines whose probes are read all lie inside their levels; then only a quad's first
+// texel is placed, ⌊y⌋·width + ⌊x⌋ in double (exact: below the level's texel count, which fits an
+// int); else all four, their indices wrapped.
+[[gnu::target("avx2")]] void place_probes(const FourLines& f, bool inside, __m256d step, int k0, int n,
+                                          const Sampler& s, FourProbes& p) {
     const __m256d width = _mm256_cvtepi32_pd(f.width);
-    const __m128i one = _mm_set1_epi32(1), below_right = _mm_add_epi32(f.width, one);
+    const __m128i one = _mm_set1_epi32(1);
     for (int c = 0; c < n; ++c) {
         const __m256d t = _mm256_mul_pd(_mm256_set1_pd(k0 + c), step);
         const __m256d x = _mm256_add_pd(f.x0, _mm256_mul_pd(t, f.sx));
@@ -126,29 +126,33 @@ struct FourProbes {
         _mm_storeu_ps(p.fy[c], _mm256_cvtpd_ps(_mm256_sub_pd(y, fy)));
         // Past a line's end, or on a line the reference takes, a value may exceed the int range:
         // the conversion gives INT_MIN there (and the sums below wrap around, defined; unread).
-        __m128i texel[4];
-        if (!wraps) {
-            texel[0] = _mm256_cvttpd_epi32(_mm256_add_pd(_mm256_mul_pd(fy, width), fx));
-            texel[1] = _mm_add_epi32(texel[0], one);
-            texel[2] = _mm_add_epi32(texel[0], f.width);
-            texel[3] = _mm_add_epi32(texel[0], below_right);
-        } else {
-            const __m128i i0 = _mm256_cvttpd_epi32(fx), j0 = _mm256_cvttpd_epi32(fy);
-            const __m128i i1 = wrap(_mm_add_epi32(i0, one), f.width, f.powers_of_two, s.wrap_u);
-            const __m128i j1 = wrap(_mm_add_epi32(j0, one), f.height, f.powers_of_two, s.wrap_v);
-            const __m128i i = wrap(i0, f.width, f.powers_of_two, s.wrap_u);
-            const __m128i row0 = _mm_mullo_epi32(wrap(j0, f.height, f.powers_of_two, s.wrap_v), f.width);
-            const __m128i row1 = _mm_mullo_epi32(j1, f.width);
-            texel[0] = _mm_add_epi32(row0, i), texel[1] = _mm_add_epi32(row0, i1);
-            texel[2] = _mm_add_epi32(row1, i), texel[3] = _mm_add_epi32(row1, i1);
+        if (inside) {  // (the other corners follow from the first: see quad)
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[0][c]),
+                             _mm256_cvttpd_epi32(_mm256_add_pd(_mm256_mul_pd(fy, width), fx)));
+            continue;
         }
+        const __m128i i0 = _mm256_cvttpd_epi32(fx), j0 = _mm256_cvttpd_epi32(fy);
+        const __m128i i1 = wrap(_mm_add_epi32(i0, one), f.width, f.powers_of_two, s.wrap_u);
+        const __m128i j1 = wrap(_mm_add_epi32(j0, one), f.height, f.powers_of_two, s.wrap_v);
+        const __m128i i = wrap(i0, f.width, f.powers_of_two, s.wrap_u);
+        const __m128i row0 = _mm_mullo_epi32(wrap(j0, f.height, f.powers_of_two, s.wrap_v), f.width);
+        const __m128i row1 = _mm_mullo_epi32(j1, f.width);
+        const __m128i texel[4] = {_mm_add_epi32(row0, i), _mm_add_epi32(row0, i1), _mm_add_epi32(row1, i),
+                                  _mm_add_epi32(row1, i1)};
         for (int corner = 0; corner < 4; ++corner)
             _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[corner][c]), texel[corner]);
     }
 }
 
-// Probe c's bilinear quad on line j.
-[[gnu::target("avx2")]] inline Texel quad(const glm::vec4* t, const FourProbes& p, int c, int j) {
+// Probe c's bilinear quad on line j. kInside: the group's lines lie inside their levels, and only
+// each quad's first texel was placed; the others are the next one and the two below them (`width`
+// texels on).
+template <bool kInside>
+[[gnu::target("avx2")]] inline Texel quad(const glm::vec4* t, const FourProbes& p, int c, int j, std::ptrdiff_t width) {
+    if constexpr (kInside) {
+        const glm::vec4* a = t + p.texel[0][c][j];
+        return lerp_quad(load(a[0]), load(a[1]), load(a[width]), load(a[width + 1]), p.fx[c][j], p.fy[c][j]);
+    }
     return lerp_quad(load(t[p.texel[0][c][j]]), load(t[p.texel[1][c][j]]), load(t[p.texel[2][c][j]]),
                      load(t[p.texel[3][c][j]]), p.fx[c][j], p.fy[c][j]);
 }
@@ -159,30 +163,33 @@ struct LineSum {
     Texel first = splat(0.0f), difference = splat(0.0f);
 };
 
-// Adds probes k0 … end − 1 (placed from k0) of line j to `sum`.
-[[gnu::target("avx2")]] inline void add_probes(const glm::vec4* t, const FourProbes& p, int j, int k0, int end,
-                                               LineSum& sum) {
+// Adds probes k0 … end − 1 (placed from k0) of line j, on a level `width` texels wide, to `sum`.
+template <bool kInside>
+[[gnu::target("avx2")]] inline void add_probes(const glm::vec4* t, const FourProbes& p, std::ptrdiff_t width, int j,
+                                               int k0, int end, LineSum& sum) {
     int k = k0;
     if (k == 0) {
-        sum.first = quad(t, p, 0, j);
+        sum.first = quad<kInside>(t, p, 0, j, width);
         ++k;
     }
-    for (; k < end; ++k) sum.difference += quad(t, p, k - k0, j) - sum.first;
+    for (; k < end; ++k) sum.difference += quad<kInside>(t, p, k - k0, j, width) - sum.first;
 }
 
 // add_probes on two levels at once: each sum in its own probe order (the same bits), the two
 // chains of additions side by side so that they overlap.
-[[gnu::target("avx2")]] inline void add_probes(const glm::vec4* ta, const FourProbes& pa, const glm::vec4* tb,
-                                               const FourProbes& pb, int j, int k0, int end, LineSum& a, LineSum& b) {
+template <bool kInside>
+[[gnu::target("avx2")]] inline void add_probes(const glm::vec4* ta, const FourProbes& pa, std::ptrdiff_t wa,
+                                               const glm::vec4* tb, const FourProbes& pb, std::ptrdiff_t wb, int j,
+                                               int k0, int end, LineSum& a, LineSum& b) {
     int k = k0;
     if (k == 0) {
-        a.first = quad(ta, pa, 0, j);
-        b.first = quad(tb, pb, 0, j);
+        a.first = quad<kInside>(ta, pa, 0, j, wa);
+        b.first = quad<kInside>(tb, pb, 0, j, wb);
         ++k;
     }
     for (; k < end; ++k) {
-        a.difference += quad(ta, pa, k - k0, j) - a.first;
-        b.difference += quad(tb, pb, k - k0, j) - b.first;
+        a.difference += quad<kInside>(ta, pa, k - k0, j, wa) - a.first;
+        b.difference += quad<kInside>(tb, pb, k - k0, j, wb) - b.first;
     }
 }
 
@@ -231,21 +238,30 @@ bool vectors_reach(bool near, const TextureLevel& level) {
         vector_lanes |= 1 << j;
         longest = std::max(longest, lanes.count[i]);
     }
+    // Whether every line the vectors take lies inside its level(s): then only each quad's first
+    // texel is placed.
+    const bool inside = (lines[0].inside & vector_lanes) == vector_lanes &&
+                        (!two_levels || (lines[1].inside & vector_lanes) == vector_lanes);
     LineSum sums[2][4];
     FourProbes probes[2];
     for (int k0 = 0; k0 < longest; k0 += kChunk) {
         const int chunk = std::min(kChunk, longest - k0);
         for (int k = 0; k < (two_levels ? 2 : 1); ++k)
-            place_probes(lines[k], vector_lanes, step, k0, chunk, s, probes[k]);
+            place_probes(lines[k], inside, step, k0, chunk, s, probes[k]);
         for (int j = 0; j < n; ++j) {
             const int i = first + j, end = std::min(k0 + chunk, lanes.count[i]);
             if (!(vector_lanes >> j & 1) || end <= k0) continue;
-            const glm::vec4* finer = lanes.finer[i]->texels.data();
-            if (lanes.coarser[i])
-                add_probes(finer, probes[0], lanes.coarser[i]->texels.data(), probes[1], j, k0, end, sums[0][j],
-                           sums[1][j]);
+            const TextureLevel &finer = *lanes.finer[i], *coarser = lanes.coarser[i];
+            if (coarser && inside)
+                add_probes<true>(finer.texels.data(), probes[0], finer.width, coarser->texels.data(), probes[1],
+                                 coarser->width, j, k0, end, sums[0][j], sums[1][j]);
+            else if (coarser)
+                add_probes<false>(finer.texels.data(), probes[0], finer.width, coarser->texels.data(), probes[1],
+                                  coarser->width, j, k0, end, sums[0][j], sums[1][j]);
+            else if (inside)
+                add_probes<true>(finer.texels.data(), probes[0], finer.width, j, k0, end, sums[0][j]);
             else
-                add_probes(finer, probes[0], j, k0, end, sums[0][j]);
+                add_probes<false>(finer.texels.data(), probes[0], finer.width, j, k0, end, sums[0][j]);
         }
     }
     alignas(32) double steps[4];
