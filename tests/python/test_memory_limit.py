@@ -2,6 +2,8 @@
 above it raise MemoryLimitError (a ValueError and a MemoryError) giving the estimate and the limit,
 before anything large is allocated."""
 import re
+import resource
+import struct
 import warnings
 
 import numpy as np
@@ -65,6 +67,18 @@ def test_keeping_samples_adds_the_sample_buffer(limit):
     assert sizes[True] - sizes[False] == 64 * 32 * 8 * 20
 
 
+def test_error_probe_draws_are_counted(limit):
+    # The probe's draws are with replacement, so probe_pixels may exceed the image's pixels; their
+    # bookkeeping (72 bytes a draw) is checked against the limit before it is allocated.
+    scene, camera = triangle_scene(), mr.Camera.look_at((0, 0, 2), (0, 0, 0))
+    limit(100 << 20)  # the render fits; 10⁷ draws (720 MB) do not
+    with pytest.raises(mr.MemoryLimitError, match="the error probe's 10000000 probe_pixels needs") as e:
+        mr.render(scene, camera, 16, 16, spp=4, threads=1, estimate_error=True, probe_pixels=10**7)
+    assert reported_bytes(str(e.value)) == 10**7 * 72 + 16 * 16 * 8
+    r = mr.render(scene, camera, 16, 16, spp=4, threads=1, estimate_error=True, probe_pixels=64)
+    assert r.error_probe.pixels == 64
+
+
 def test_rasterize_and_texture_refused(limit):
     limit(1 << 20)
     with pytest.raises(mr.MemoryLimitError, match="rasterizing 1000x1000 pixels at 1 sample per pixel needs"):
@@ -87,6 +101,32 @@ def test_image_read_refused_before_decoding(limit, tmp_path):
     limit(needed - 1)
     with pytest.raises(mr.MemoryLimitError):
         mr.read_image(path)
+
+
+def gif(width, height):
+    """A GIF of one 1x1 black frame on a width x height logical screen (header, two-colour
+    palette, image descriptor, LZW data, trailer)."""
+    header = b"GIF89a" + struct.pack("<HHBBB", width, height, 0x80, 0, 0) + bytes(6)
+    return header + b"\x2c" + struct.pack("<HHHHB", 0, 0, 1, 1, 0) + b"\x02\x02\x44\x01\x00\x3b"
+
+
+def test_gif_screen_size_refused_before_decoding(limit, tmp_path):
+    # OpenImageIO's GIF reader allocates the logical screen as it opens the file: its header is
+    # judged first, as other formats' are (a 40-byte file claiming 20000² pixels took 1.6 GB).
+    small = tmp_path / "small.gif"
+    small.write_bytes(gif(3, 2))
+    assert mr.read_image(small).shape == (2, 3, 4)
+    big = tmp_path / "big.gif"
+    big.write_bytes(gif(20000, 20000))
+    limit(64 << 20)
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with pytest.raises(mr.MemoryLimitError, match=r"reading '.*big\.gif' \(20000x20000x4\) needs"):
+        mr.read_image(big)
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 64 << 10  # (KiB)
+    huge = tmp_path / "huge.gif"
+    huge.write_bytes(gif(30000, 30000))
+    with pytest.raises(OSError, match=r"huge\.gif' is too large \(30000x30000 pixels"):
+        mr.read_image(huge)
 
 
 def test_scene_file_textures_within_the_limit(limit, tmp_path):

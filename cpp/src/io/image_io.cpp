@@ -10,8 +10,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -118,6 +120,26 @@ void write_image(const std::string& path, const Image& image) {
 
 namespace {
 
+// Refuses an image of w × h pixels and nch channels above kMaxReadPixels, or whose decoding
+// (the stored channels as float, and as bytes first for 8-bit files, then RGBA float) would
+// exceed the memory limit.
+void check_read_size(int w, int h, int nch, const std::string& name) {
+    const std::uint64_t pixels = std::uint64_t(w) * std::uint64_t(h);
+    if (pixels > kMaxReadPixels)
+        throw std::runtime_error("read_image: '" + name + "' is too large (" + std::to_string(w) + "x" +
+                                 std::to_string(h) + " pixels; at most " + std::to_string(kMaxReadPixels) + ")");
+    check_memory(pixels * std::uint64_t(nch) * (sizeof(float) + 1) + pixels * 4 * sizeof(float),
+                 "reading '" + name + "' (" + std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(nch) + ")");
+}
+
+// OpenImageIO's GIF reader decodes the first frame into a canvas of the logical screen's size
+// as it opens the file, before its size can be checked: the size from the header first (bytes
+// 6–9, little-endian), checked as for RGBA. `b`: the file's first `size` bytes.
+void check_gif_header(const unsigned char* b, std::size_t size, const std::string& name) {
+    if (size < 10 || std::memcmp(b, "GIF8", 4) != 0) return;
+    check_read_size(b[6] | b[7] << 8, b[8] | b[9] << 8, 4, name);
+}
+
 // Step: read every channel of an opened file, decode and premultiply (read_image's contract;
 // `options` says how integer colour and alpha are taken). `name` is the path or the memory
 // image's name, for messages.
@@ -127,14 +149,8 @@ Image decode_image(OIIO::ImageInput& in, const std::string& name, const ImageRea
     if (w <= 0 || h <= 0 || nch <= 0)
         throw std::runtime_error("read_image: '" + name + "' has no pixels (" + std::to_string(w) + "x" +
                                  std::to_string(h) + "x" + std::to_string(nch) + ")");
+    check_read_size(w, h, nch, name);
     const std::uint64_t values = std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(nch);
-    if (std::uint64_t(w) * std::uint64_t(h) > kMaxReadPixels)
-        throw std::runtime_error("read_image: '" + name + "' is too large (" + std::to_string(w) + "x" +
-                                 std::to_string(h) + " pixels; at most " + std::to_string(kMaxReadPixels) + ")");
-    // The stored channels as float (and as bytes first for 8-bit files), then RGBA float.
-    const std::uint64_t pixels = std::uint64_t(w) * std::uint64_t(h);
-    check_memory(values * (sizeof(float) + 1) + pixels * 4 * sizeof(float),
-                 "reading '" + name + "' (" + std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(nch) + ")");
 
     // Read every channel as float in [0, 1] (integers) or as stored (floats).
     const OIIO::TypeDesc stored = spec.format;
@@ -185,6 +201,21 @@ Image decode_image(OIIO::ImageInput& in, const std::string& name, const ImageRea
     return image;
 }
 
+// Opens and decodes with OpenImageIO, whose readers can fail by throwing (a corrupt header
+// asking for an impossible allocation): their exceptions become read_image's runtime_error.
+template <typename Open>
+Image open_and_decode(Open&& open, const std::string& name, const ImageReadOptions& options) {
+    try {
+        std::unique_ptr<OIIO::ImageInput> in = open();
+        return decode_image(*in, name, options);
+    } catch (const std::bad_alloc&) {
+        throw std::runtime_error("read_image: cannot read '" + name + "': the decoder ran out of memory");
+    } catch (const std::length_error& e) {
+        throw std::runtime_error("read_image: cannot read '" + name + "': corrupt (the decoder failed: " +
+                                 e.what() + ")");
+    }
+}
+
 // The file format's extension, from the first bytes (OpenImageIO picks its reader by name).
 std::string sniff_extension(const unsigned char* b, std::size_t size) {
     auto starts = [&](const char* magic, std::size_t n) { return size >= n && std::memcmp(b, magic, n) == 0; };
@@ -205,16 +236,26 @@ Image read_image(const std::string& path) { return read_image(path, ImageReadOpt
 
 Image read_image(const std::string& path, const ImageReadOptions& options) {
     // Open, asking for the file's own (straight) alpha so that we premultiply in linear space.
+    unsigned char header[10];
+    std::size_t got = 0;
+    if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+        got = std::fread(header, 1, sizeof header, f);
+        std::fclose(f);
+    }
+    check_gif_header(header, got, path);
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = OIIO::ImageInput::open(path, &config);
-    if (!in) {
-        std::string message = OIIO::geterror();
-        std::error_code ec;
-        if (!std::filesystem::exists(path, ec)) message = "no such file";
-        throw std::runtime_error("read_image: cannot read '" + path + "': " + message);
-    }
-    return decode_image(*in, path, options);
+    const auto open = [&] {
+        auto in = OIIO::ImageInput::open(path, &config);
+        if (!in) {
+            std::string message = OIIO::geterror();
+            std::error_code ec;
+            if (!std::filesystem::exists(path, ec)) message = "no such file";
+            throw std::runtime_error("read_image: cannot read '" + path + "': " + message);
+        }
+        return in;
+    };
+    return open_and_decode(open, path, options);
 }
 
 Image read_image_from_memory(const void* bytes, std::size_t size, const std::string& name,
@@ -225,6 +266,7 @@ Image read_image_from_memory(const void* bytes, std::size_t size, const std::str
     if (ext.empty())
         throw std::runtime_error("read_image: cannot read '" + name +
                                  "': not a recognized image format (expected PNG, JPEG, EXR, WebP, GIF, BMP, TIFF or HDR)");
+    check_gif_header(b, size, name);
     OIIO::Filesystem::IOMemReader proxy(b, size);
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
@@ -233,9 +275,12 @@ Image read_image_from_memory(const void* bytes, std::size_t size, const std::str
     OIIO::Filesystem::IOProxy* proxy_pointer = &proxy;
     config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_pointer);
     // The name only tells OpenImageIO the format; the bytes come from the proxy.
-    auto in = OIIO::ImageInput::open("memory" + ext, &config, &proxy);
-    if (!in) throw std::runtime_error("read_image: cannot read '" + name + "': " + OIIO::geterror());
-    return decode_image(*in, name, options);
+    const auto open = [&] {
+        auto in = OIIO::ImageInput::open("memory" + ext, &config, &proxy);
+        if (!in) throw std::runtime_error("read_image: cannot read '" + name + "': " + OIIO::geterror());
+        return in;
+    };
+    return open_and_decode(open, name, options);
 }
 
 }  // namespace mipraster

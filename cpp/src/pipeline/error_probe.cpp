@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "mipraster/core/constants.hpp"
+#include "mipraster/core/memory_limit.hpp"
 #include "mipraster/core/splitmix.hpp"
 
 namespace mipraster {
@@ -177,7 +178,15 @@ ErrorProbe measure_error(const std::vector<Draw>& draws, const Camera& camera, c
                                     std::to_string(reuse->height) + " image, got " + color.to_string());
     ProbeReference fresh;
     ProbeReference& r = reuse ? *reuse : fresh;
-    if (r.empty()) r = draw_probe_pixels(guide ? *guide : error_guide(color, halves_map), pixels, seed);
+    if (r.empty()) {
+        // Per draw: its pixel twice (chosen, distinct), its probability and slot, a pixel's running
+        // mean and m2 (three channels each); per image pixel, the guide's cumulative sum.
+        check_memory(static_cast<std::uint64_t>(pixels) * (2 * sizeof(std::uint32_t) + sizeof(double) +
+                                                             sizeof(std::size_t) + 6 * sizeof(double)) +
+                         n_all * sizeof(double),
+                     "the error probe's " + std::to_string(pixels) + " probe_pixels");
+        r = draw_probe_pixels(guide ? *guide : error_guide(color, halves_map), pixels, seed);
+    }
     const std::vector<std::uint32_t>& chosen = r.chosen;
     const std::vector<std::uint32_t>& distinct = r.distinct;
     const std::vector<double>& p = r.probability;
