@@ -269,6 +269,23 @@ def test_obj_coordinate_that_is_not_a_number_is_an_error(tmp_path):
         mr.load_scene(path)
 
 
+@pytest.mark.parametrize("corner", ["4294967297", "99999999999999999999", "2147483648", "1/4294967297", "1//x"])
+def test_obj_face_index_beyond_an_int_is_an_error(tmp_path, corner):
+    # tinyobjloader wrapped such indices around: 'f 1 2 4294967297' loaded as the triangle 1 2 1.
+    path = tmp_path / "index.obj"
+    path.write_text(f"v -1 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1 2 {corner}\n")
+    part = corner.split("/")[-1]
+    with pytest.raises(OSError, match=rf"line 5 \('f 1 2 {corner}'\): '{part}' is not an index"):
+        mr.load_scene(path)
+    # The largest index that fits is only out of range, and relative indices still load.
+    path.write_text("v -1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2147483647\n")
+    with pytest.raises(OSError, match="vertex index 2147483647 out of range"):
+        mr.load_scene(path)
+    path.write_text("v -1 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n")
+    scene, _ = mr.load_scene(path)
+    assert scene.draws[0].mesh.triangles.tolist() == [[0, 1, 2]]
+
+
 def test_scene_file_renders_are_deterministic(tmp_path):
     # A textured glTF seen at a grazing angle (minification, edges): the same bits on every run,
     # for any thread count, through Python and through the CLI (with anisotropic filtering).

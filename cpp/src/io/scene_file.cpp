@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -88,8 +90,10 @@ struct ObjGroup {
     bool all_uvs = true, all_normals = true;  // every corner has one
 };
 
-// tinyobjloader reads a coordinate it cannot parse ("nan", "inf", "1,5", "x") as 0: a silently
-// wrong mesh. Every number of the v / vt / vn lines must parse completely and be finite.
+// tinyobjloader reads a coordinate it cannot parse ("nan", "inf", "1,5", "x") as 0, and a face
+// index beyond 32 bits wrapped around: a silently wrong mesh. Every number of the v / vt / vn lines
+// must parse completely and be finite, and every index of the f lines must be an integer that
+// fits an int (negative ones count back from the end).
 void check_obj_numbers(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) fail(path, "cannot open OBJ file");
@@ -98,13 +102,30 @@ void check_obj_numbers(const std::string& path) {
         std::istringstream words(line);
         std::string keyword, word;
         words >> keyword;
+        const auto bad = [&](const std::string& what) {
+            fail(path, "line " + std::to_string(number) + " ('" + trim(line) + "'): " + what);
+        };
+        if (keyword == "f") {
+            while (words >> word && word[0] != '#') {
+                std::istringstream parts(word);
+                for (std::string part; std::getline(parts, part, '/');) {
+                    if (part.empty()) continue;  // (v//vn: no texture coordinate)
+                    errno = 0;
+                    char* end = nullptr;
+                    const long long index = std::strtoll(part.c_str(), &end, 10);
+                    if (end != part.c_str() + part.size() || errno == ERANGE ||
+                        index > std::numeric_limits<int>::max() || index < -std::numeric_limits<int>::max())
+                        bad("'" + part + "' is not an index (an integer of at most " +
+                            std::to_string(std::numeric_limits<int>::max()) + " in magnitude)");
+                }
+            }
+            continue;
+        }
         if (keyword != "v" && keyword != "vt" && keyword != "vn") continue;
         while (words >> word && word[0] != '#') {
             char* end = nullptr;
             const double value = std::strtod(word.c_str(), &end);
-            if (end != word.c_str() + word.size() || !std::isfinite(value))
-                fail(path, "line " + std::to_string(number) + " ('" + trim(line) + "'): '" + word +
-                               "' is not a finite number");
+            if (end != word.c_str() + word.size() || !std::isfinite(value)) bad("'" + word + "' is not a finite number");
         }
     }
 }
