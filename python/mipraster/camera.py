@@ -107,8 +107,9 @@ class Camera:
         if not (math.isfinite(extent) and extent > 0.0):
             raise ValueError(f"height: expected a finite view height > 0 in world units, got {extent:g}")
         n, f = _checks.real(near, "near"), _checks.real(far, "far")
-        if not (math.isfinite(n) and math.isfinite(f) and f > n):
-            raise ValueError(f"near, far: expected finite values with near < far, got near={n:g}, far={f:g}")
+        if not (math.isfinite(n) and math.isfinite(f) and f > n and math.isfinite(f - n)):
+            raise ValueError(f"near, far: expected finite values with near < far and a finite far - near, got "
+                             f"near={n:g}, far={f:g}")
         view = _core.look_at(eye_v, target_v, up_v)
 
         def build(width: int, image_height: int) -> _core.Camera:

@@ -235,6 +235,11 @@ def test_orthographic_maps_world_units_linearly():
         (lambda: mr.Camera.look_at((0, 0, 1), (0, 0, 0), fov_y="wide"), TypeError, ["fov_y"]),
         (lambda: mr.Camera.orthographic((0, 0, 1), (0, 0, 0), height=0), ValueError, ["height"]),
         (lambda: mr.Camera.orthographic((0, 0, 1), (0, 0, 0), near=5, far=5), ValueError, ["near", "far"]),
+        # finite bounds whose difference overflows: the depth scale was 0, every sample failed its test
+        (lambda: mr.Camera.orthographic((0, 0, 1), (0, 0, 0), near=-9e307, far=9e307), ValueError,
+         ["near", "far", "far - near"]),
+        (lambda: mr._core.orthographic(-1e308, 1e308, -1, 1, 0, 1), ValueError, ["orthographic", "r - l"]),
+        (lambda: mr._core.orthographic(-1, 1, 0, 1e-310, 0, 1), ValueError, ["orthographic", "t - b"]),
         (lambda: mr.Camera.from_matrices(np.eye(4), np.eye(3)), ValueError, ["projection", "(4, 4)", "(3, 3)"]),
         (lambda: mr.Camera.from_matrices(np.full((4, 4), np.inf), np.eye(4)), ValueError, ["view[0, 0]", "inf"]),
         (lambda: mr.Camera.from_matrices(np.eye(4), np.eye(4), "directx"), ValueError,

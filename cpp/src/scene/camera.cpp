@@ -91,6 +91,13 @@ glm::dmat4 orthographic(double l, double r, double b, double t, double n, double
         m[2][2] = 1.0 / (f - n);
         m[3][2] = f / (f - n);
     }
+    // Finite bounds can still overflow their difference (r − l = ∞ gave a zero scale and a blank
+    // image) or make it so small that its reciprocal overflows.
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j)
+            require(std::isfinite(m[i][j]) && (i != j || m[i][j] != 0.0),
+                    "orthographic: the extents r - l, t - b and far - near must be finite, nonzero and not so small "
+                    "that their reciprocals overflow");
     return m;
 }
 
