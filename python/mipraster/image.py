@@ -30,12 +30,23 @@ def _image_module() -> ModuleType:
 
 
 def _path(path: Any) -> str:
+    """A path as the C++ side takes it (UTF-8); ValueError for one it would read differently."""
     if isinstance(path, bytes):
-        return os.fsdecode(path)
+        path = os.fsdecode(path)
     try:
-        return os.fspath(path)
+        p = os.fspath(path)
     except TypeError:
         raise TypeError(f"path: expected str or os.PathLike, got {type(path).__name__}") from None
+    if not isinstance(p, str):
+        p = os.fsdecode(p)
+    if "\0" in p:  # the C++ side would stop at it: 'a\0b.png' wrote a file named 'a'
+        raise ValueError(f"path: {p!r} contains a NUL character")
+    try:
+        p.encode("utf-8")
+    except UnicodeEncodeError:
+        raise ValueError(f"path: {p!r} is not valid Unicode (a lone surrogate: a file name in another "
+                         "encoding); rename the file") from None
+    return p
 
 
 def _float_image(image: Any, name: str) -> np.ndarray:

@@ -184,3 +184,16 @@ def test_write_image_refuses_bad_arrays(tmp_path, image, error, words):
 def test_bad_path_type():
     with pytest.raises(TypeError, match="path"):
         mr.write_image(42, np.zeros((2, 2, 4)))
+
+
+@pytest.mark.parametrize("name, words", [("a\0b.png", "contains a NUL character"),
+                                         ("a\udcffb.png", "is not valid Unicode")])
+def test_path_the_file_system_would_read_differently(tmp_path, name, words):
+    # The C++ side stopped at a NUL ('a\0b.png' wrote a file named 'a'); a lone surrogate gave
+    # pybind11's 'incompatible function arguments'.
+    path = str(tmp_path / name)
+    for call in (lambda: mr.write_image(path, np.zeros((2, 2, 4))), lambda: mr.read_image(path),
+                 lambda: mr.load_scene(path)):
+        with pytest.raises(ValueError, match=words):
+            call()
+    assert list(tmp_path.iterdir()) == []
