@@ -405,3 +405,72 @@ def test_raster_keeps_a_copy_of_the_clip_positions():
     np.testing.assert_array_equal(raster.w, pos[:, 3])
     pos[:] = 0.0  # the caller's array (already float64 and contiguous) may change afterwards
     assert (raster.pos_clip[:, 3] > 0).all()
+
+
+def exact_coverage(pos, width, height, band=0.01):
+    """Whether each pixel centre lies inside the triangle pos (clip space, every w > 0), by exact
+    rational arithmetic on the given doubles; None within `band` px of an edge's line (snapping
+    to 1/256 px may move a centre that close across it)."""
+    from fractions import Fraction
+
+    screen = [((Fraction(x) / Fraction(w) + 1) * width / 2, (1 - Fraction(y) / Fraction(w)) * height / 2)
+              for x, y, _, w in pos]
+    (ax, ay), (bx, by), (cx, cy) = screen
+    orientation = 1 if (bx - ax) * (cy - ay) - (by - ay) * (cx - ax) > 0 else -1
+    out = np.empty((height, width), dtype=object)
+    for row in range(height):
+        for col in range(width):
+            px, py = Fraction(2 * col + 1, 2), Fraction(2 * row + 1, 2)
+            inside, near = True, False
+            for (x0, y0), (x1, y1) in zip(screen, screen[1:] + screen[:1]):
+                cross = (x1 - x0) * (py - y0) - (y1 - y0) * (px - x0)
+                near |= abs(float(cross)) < band * float(np.hypot(float(x1 - x0), float(y1 - y0)))
+                inside &= cross * orientation >= 0
+            out[row, col] = None if near else inside
+    return out
+
+
+def test_edges_between_vertices_far_beyond_the_guard_band_cross_the_image_exactly():
+    # An edge whose two vertices lie 10^15 to 10^30 px out on opposite sides, its line through the
+    # image: its crossings of the guard band are small differences of huge numbers (10^21 px
+    # covered nothing, 10^22 a quarter of the pixels). Lines through the centre at any angle, or
+    # along a row or a column; scaling by powers of two keeps the intended line exact.
+    rng = np.random.default_rng(7)
+    W, H = 24, 16
+    for trial in range(60):
+        e = rng.uniform(15, 30)
+        angle = rng.uniform(0, 2 * np.pi)
+        d = 10**e * np.array([np.cos(angle), np.sin(angle)])
+        if trial % 3 == 0:
+            v0, v1 = d, -d * 2.0 ** rng.integers(-3, 4)
+        else:
+            axis = trial % 3 - 1  # the coordinate that runs far out
+            v0 = np.full(2, rng.uniform(-0.9, 0.9))
+            v0[axis] = 10**e
+            v1 = v0.copy()
+            v1[axis] = -(10**e) * 2.0 ** rng.integers(-3, 4)
+        side = 10 ** rng.uniform(15, 30) * np.array([-np.sin(angle), np.cos(angle)])
+        ndc = np.array([v0, v1, side + rng.uniform(-0.3, 0.3) * d])
+        w = 2.0 ** rng.integers(-3, 4, 3).astype(float)
+        pos = np.concatenate([ndc * w[:, None], rng.uniform(-0.5, 0.5, (3, 1)) * w[:, None], w[:, None]], axis=1)
+        expected = exact_coverage(pos, W, H)
+        got = mr.rasterize(pos, [[0, 1, 2]], W, H).triangle_id[..., 0] >= 0
+        decided = expected != None  # noqa: E711 (element-wise)
+        assert decided.sum() > W * H // 2
+        assert np.array_equal(got[decided], expected[decided].astype(bool)), (trial, pos)
+
+
+def test_huge_triangle_through_a_camera_covers_what_a_small_one_does():
+    # The same triangle scaled by 10^3 … 10^30, and a camera zoomed in 10^20 times: the upper half
+    # of the image each time.
+    camera = mr.Camera.look_at((0, 0, 3), (0, 0, 0))
+    triangle = np.array([[-1, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    for k in (1e3, 1e20, 1e21, 1e22, 1e30):
+        scene = mr.Scene()
+        scene.add(mr.Mesh(triangle * k, [[0, 1, 2]]))
+        alpha = mr.render(scene, camera, 16, 16).color[..., 3]
+        assert np.array_equal(alpha, np.repeat([[1.0], [0.0]], 8, axis=0) * np.ones((16, 16))), k
+    scene = mr.Scene()
+    scene.add(mr.Mesh(triangle, [[0, 1, 2]]))
+    zoomed = mr.render(scene, mr.Camera.look_at((0, 0, 3), (0, 0, 0), fov_y=1e-20), 16, 16).color[..., 3]
+    assert zoomed[:8].all() and not zoomed[8:].any()

@@ -1,5 +1,6 @@
 #include "mipraster/pipeline/clip.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -34,25 +35,57 @@ bool lexicographically_less(const glm::dvec4& a, const glm::dvec4& b) {
     return false;
 }
 
+#if defined(__SIZEOF_FLOAT128__)
+using Quad = __float128;  // (IEEE binary128 in software: 113-bit significands)
+#else
+using Quad = long double;
+#endif
+
+// Endpoints farther out than this many times the smaller |w| of the two: their distances from
+// the plane, in double, are off by up to 2^-53 of their size, which moves the crossing along the
+// edge by up to 2^-27 in x/w and y/w, 2^-12 px at the largest image. Beyond, the crossing is
+// recomputed in Quad (a triangle of 10^21 px covered nothing, one of 10^22 a quarter of its
+// pixels).
+constexpr double kWideCrossingRatio = 0x1p26;
+
 // The point where edge (a, b) crosses the plane, always computed from the endpoint nearer the
 // plane (on a tie, the lexicographically smaller) so that (a, b) and (b, a) give the same bits.
 // From the far endpoint, a crossing next to a vertex 10^20 behind the eye came out as the
 // difference of two numbers of 10^19, rounded to w = 0. Position and weights are computed in long
 // double and rounded once: an endpoint 10^15 px away has a double ulp of 1/8 px, and
 // a + t·(b − a) in double would move the crossing that far off the edge's line (stress suite,
-// case 3); the crossing itself lies near the guard band, where double is ample.
-ClipVertex intersect(const ClipVertex& a, double da, const ClipVertex& b, double db) {
+// case 3); the crossing itself lies near the guard band, where double is ample. Endpoints beyond
+// kWideCrossingRatio take Quad throughout, the distances included (exact products of doubles).
+ClipVertex intersect(const ClipPlane& plane, const ClipVertex& a, double da, const ClipVertex& b, double db) {
     const double off_a = std::fabs(da), off_b = std::fabs(db);  // distances from the plane
     if (off_b < off_a || (off_b == off_a && lexicographically_less(b.position, a.position)))
-        return intersect(b, db, a, da);
-    using Wide = long double;
-    const Wide t = Wide(da) / (Wide(da) - Wide(db));
-    ClipVertex out;
-    for (int i = 0; i < 4; ++i)
-        out.position[i] = static_cast<double>(Wide(a.position[i]) + t * (Wide(b.position[i]) - Wide(a.position[i])));
-    for (int i = 0; i < 3; ++i)
-        out.weights[i] = static_cast<double>(Wide(a.weights[i]) + t * (Wide(b.weights[i]) - Wide(a.weights[i])));
-    return out;
+        return intersect(plane, b, db, a, da);
+    double size = 0.0;
+    for (int i = 0; i < 4; ++i) size = std::max({size, std::fabs(a.position[i]), std::fabs(b.position[i])});
+    const bool wide = !(size <= kWideCrossingRatio * std::min(std::fabs(a.position.w), std::fabs(b.position.w)));
+    const auto crossing = [&](auto wide_zero) {
+        using Wide = decltype(wide_zero);
+        Wide t = Wide(da) / (Wide(da) - Wide(db));
+        if (wide) {
+            const auto distance = [&](const glm::dvec4& p) {
+                Wide d = Wide(plane.offset);
+                for (int i = 0; i < 4; ++i) d += Wide(plane.normal[i]) * Wide(p[i]);
+                return d;
+            };
+            const Wide wa = distance(a.position), wb = distance(b.position);
+            // (The double distances chose the edge; in Quad the crossing may land a hair beyond
+            // an endpoint, or their difference be 0: kept on the edge.)
+            t = wa == wb ? Wide(0) : wa / (wa - wb);
+            t = t < Wide(0) ? Wide(0) : (t > Wide(1) ? Wide(1) : t);
+        }
+        ClipVertex out;
+        for (int i = 0; i < 4; ++i)
+            out.position[i] = static_cast<double>(Wide(a.position[i]) + t * (Wide(b.position[i]) - Wide(a.position[i])));
+        for (int i = 0; i < 3; ++i)
+            out.weights[i] = static_cast<double>(Wide(a.weights[i]) + t * (Wide(b.weights[i]) - Wide(a.weights[i])));
+        return out;
+    };
+    return wide ? crossing(Quad(0)) : crossing(static_cast<long double>(0));
 }
 
 }  // namespace
@@ -90,7 +123,7 @@ ClipOutcome clip_triangle(const std::array<glm::dvec4, 3>& p, const std::array<s
             const ClipVertex& b = src->vertices[(i + 1) % src->count];
             const double da = plane.distance(a.position), db = plane.distance(b.position);
             if (da >= 0.0) dst->vertices[dst->count++] = a;
-            if ((da >= 0.0) != (db >= 0.0)) dst->vertices[dst->count++] = intersect(a, da, b, db);
+            if ((da >= 0.0) != (db >= 0.0)) dst->vertices[dst->count++] = intersect(plane, a, da, b, db);
         }
         std::swap(src, dst);
         if (src->count < 3) {
