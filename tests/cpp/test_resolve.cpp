@@ -15,7 +15,9 @@
 
 #include "helpers.hpp"
 #include "mipraster/core/colour.hpp"
+#include "mipraster/core/thread_pool.hpp"
 #include "mipraster/pipeline/resolve.hpp"
+#include "mipraster/pipeline/sample_pattern.hpp"
 #include "oracle.hpp"
 
 namespace {
@@ -160,6 +162,30 @@ TEST(Resolve, SamplesNearTheFloatMaximumResolveToTheirFiniteMean) {
         mr::resolve_tile(mr::color_window(fb), 0, 0, 2, 1, mr::ResolveFilter::box, img);
         for (int c = 0; c < 4; ++c) EXPECT_EQ(img.at(0, 0, c), big) << "S=" << S;
         EXPECT_EQ(img.at(1, 0, 0), 0.0f) << "S=" << S;
+    }
+}
+
+// The wide filters too: their weighted sums of finite samples near the float maximum stay finite
+// (in float they overflowed to infinity, and negative lobes made NaN). A constant frame of the
+// maximum resolves to that constant, within rounding, and a frame of alternating signs near it
+// to a finite value.
+TEST(Resolve, WideFiltersOfSamplesNearTheFloatMaximumStayFinite) {
+    const float big = std::numeric_limits<float>::max();
+    mr::ThreadPool pool(1);
+    for (mr::ResolveFilter filter : {mr::ResolveFilter::tent, mr::ResolveFilter::mitchell,
+                                     mr::ResolveFilter::catmull_rom, mr::ResolveFilter::lanczos3}) {
+        const mr::SamplePattern pattern = mr::make_sample_pattern(mr::PatternKind::grid, 4);
+        mr::Framebuffer fb;
+        fb.width = 7;
+        fb.height = 5;
+        fb.samples = 4;
+        fb.color.assign(static_cast<std::size_t>(7 * 5 * 4 * 4), big);
+        mr::Image img;
+        mr::resolve_framebuffer(fb, pattern, filter, pool, img);
+        for (float v : img.pixels) EXPECT_NEAR(v / big, 1.0f, 1e-6f) << mr::to_string(filter);
+        for (std::size_t i = 0; i < fb.color.size(); i += 4) fb.color[i] = (i / 4) % 3 ? big : -big;
+        mr::resolve_framebuffer(fb, pattern, filter, pool, img);
+        for (float v : img.pixels) EXPECT_TRUE(std::isfinite(v)) << mr::to_string(filter);
     }
 }
 

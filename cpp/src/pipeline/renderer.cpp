@@ -378,6 +378,7 @@ std::uint64_t render_bytes(const std::vector<Draw>& draws, const RenderSettings&
     const bool wide_resolve = settings.resolve_filter != ResolveFilter::box && settings.samples > 1;
     if (settings.keep_samples || wide_resolve)
         bytes += framebuffer_bytes(settings.width, settings.height, settings.samples, needs_depth);
+    if (wide_resolve) bytes += pixels * std::uint64_t(settings.samples) * 4 * sizeof(double);  // its row sums
     bytes += std::uint64_t(threads) * kTileSize * kTileSize * std::uint64_t(settings.samples) * sample_bytes;
     for (const Draw& d : draws) bytes += geometry_bytes(d.mesh->positions.size(), d.mesh->triangles.size());
     return bytes;

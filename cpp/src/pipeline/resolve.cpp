@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <type_traits>
 #include <vector>
@@ -154,9 +155,10 @@ void resolve_framebuffer(const Framebuffer& fb, const SamplePattern& pattern, Re
 
     // Pass 1, along rows: per pixel and sample s, the sum over the neighbouring pixels of the
     // x-weight times sample s's colour, and (per column and sample) the sum of the x-weights
-    // inside the frame.
-    std::vector<float> row_sums(fb.color.size());
-    std::vector<float> x_weight(static_cast<std::size_t>(W) * S, 0.0f);
+    // inside the frame. The sums in double, as the box filter's: in float, samples near the float
+    // maximum summed to infinity (or, with negative lobes, to NaN) though the result is finite.
+    std::vector<double> row_sums(fb.color.size());
+    std::vector<double> x_weight(static_cast<std::size_t>(W) * S, 0.0);
     for (int x = 0; x < W; ++x)
         for (int n = std::max(-tx.reach, -x); n <= std::min(tx.reach, W - 1 - x); ++n)
             for (int s = 0; s < S; ++s) x_weight[static_cast<std::size_t>(x) * S + s] += tx.at(n, s);
@@ -164,11 +166,11 @@ void resolve_framebuffer(const Framebuffer& fb, const SamplePattern& pattern, Re
         const auto [y0, y1] = rows_of(t);
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < W; ++x) {
-                float* dst = &row_sums[fb.sample_index(x, y, 0) * 4];
+                double* dst = &row_sums[fb.sample_index(x, y, 0) * 4];
                 for (int n = std::max(-tx.reach, -x); n <= std::min(tx.reach, W - 1 - x); ++n) {
                     const float* src = &fb.color[fb.sample_index(x + n, y, 0) * 4];
                     for (int s = 0; s < S; ++s) {
-                        const float w = tx.at(n, s);
+                        const double w = tx.at(n, s);
                         for (int c = 0; c < 4; ++c) dst[4 * s + c] += w * src[4 * s + c];
                     }
                 }
@@ -179,26 +181,29 @@ void resolve_framebuffer(const Framebuffer& fb, const SamplePattern& pattern, Re
     // divided by the total weight of the samples inside the frame.
     pool.parallel_for(tasks, [&](std::size_t t) {
         const auto [y0, y1] = rows_of(t);
-        std::vector<float> y_weight(static_cast<std::size_t>(S));
+        std::vector<double> y_weight(static_cast<std::size_t>(S));
         for (int y = y0; y < y1; ++y) {
             const int n0 = std::max(-ty.reach, -y), n1 = std::min(ty.reach, H - 1 - y);
             for (int s = 0; s < S; ++s) {
-                y_weight[static_cast<std::size_t>(s)] = 0.0f;
+                y_weight[static_cast<std::size_t>(s)] = 0.0;
                 for (int n = n0; n <= n1; ++n) y_weight[static_cast<std::size_t>(s)] += ty.at(n, s);
             }
             for (int x = 0; x < W; ++x) {
-                float acc[4] = {0, 0, 0, 0};
+                double acc[4] = {0, 0, 0, 0};
                 for (int n = n0; n <= n1; ++n) {
-                    const float* src = &row_sums[fb.sample_index(x, y + n, 0) * 4];
+                    const double* src = &row_sums[fb.sample_index(x, y + n, 0) * 4];
                     for (int s = 0; s < S; ++s) {
-                        const float w = ty.at(n, s);
+                        const double w = ty.at(n, s);
                         for (int c = 0; c < 4; ++c) acc[c] += w * src[4 * s + c];
                     }
                 }
-                float total = 0.0f;
+                double total = 0.0;
                 for (int s = 0; s < S; ++s)
                     total += x_weight[static_cast<std::size_t>(x) * S + s] * y_weight[static_cast<std::size_t>(s)];
-                for (int c = 0; c < 4; ++c) out.at(x, y, c) = acc[c] / total;
+                // (A filter with negative lobes can overshoot the largest sample: beyond float's
+                // range, the nearest float is its largest.)
+                constexpr double kMax = std::numeric_limits<float>::max();
+                for (int c = 0; c < 4; ++c) out.at(x, y, c) = static_cast<float>(std::clamp(acc[c] / total, -kMax, kMax));
             }
         }
     });
