@@ -6,6 +6,8 @@
 // pixel again; bad input names itself.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -47,6 +49,19 @@ TEST(ErrorProbe, GuideIsTheLargestHalfStepPlusTheSpreadHalves) {
     EXPECT_FLOAT_EQ(gh.at(2, 0, 0), 1.0f);
     mr::Image wrong(2, 1, 1);
     EXPECT_THROW(mr::error_guide(c, &wrong), std::invalid_argument);
+}
+
+TEST(ErrorProbe, GuideOfColoursNearTheFloatMaximumIsFinite) {
+    // A step of 2·10³⁸ squares to 10⁷⁶: in float that was infinity, and the probe's draw
+    // probabilities (guide / total) NaN. The guide keeps it at the largest float.
+    mr::Image c(2, 1, 4);
+    for (int ch = 0; ch < 3; ++ch) c.at(0, 0, ch) = -1e38f, c.at(1, 0, ch) = 1e38f;
+    mr::Image h(2, 1, 1);
+    h.at(0, 0, 0) = 1e30f;
+    for (const mr::Image* halves : std::vector<const mr::Image*>{nullptr, &h}) {
+        const mr::Image g = mr::error_guide(c, halves);
+        for (float v : g.pixels) EXPECT_EQ(v, std::numeric_limits<float>::max());
+    }
 }
 
 TEST(ErrorProbe, MeasuresAHalfCoveredColumn) {

@@ -107,15 +107,18 @@ Image error_guide(const Image& color, const Image* halves_map) {
     if (color.channels < 3) throw std::invalid_argument("color: expected 3 or 4 channels, got " + color.to_string());
     const int w = color.width, h = color.height;
     Image g(w, h, 1);
-    // The largest mean over R, G, B of (half the step)² to a neighbour.
+    // The largest mean over R, G, B of (half the step)² to a neighbour. In double, kept at most
+    // the largest float: in float, colours of 10²⁰ squared to infinity, and the probe's draw
+    // probabilities (guide / total) became NaN.
+    const auto saturated = [](double v) { return static_cast<float>(std::min<double>(v, std::numeric_limits<float>::max())); };
     auto step = [&](int x0, int y0, int x1, int y1) {
-        float s = 0.0f;
+        double s = 0.0;
         for (int c = 0; c < 3; ++c) {
-            const float d = color.at(x1, y1, c) - color.at(x0, y0, c);
-            s += d * d / 12.0f;
+            const double d = double(color.at(x1, y1, c)) - color.at(x0, y0, c);
+            s += d * d / 12.0;
         }
-        g.at(x0, y0, 0) = std::max(g.at(x0, y0, 0), s);
-        g.at(x1, y1, 0) = std::max(g.at(x1, y1, 0), s);
+        g.at(x0, y0, 0) = std::max(g.at(x0, y0, 0), saturated(s));
+        g.at(x1, y1, 0) = std::max(g.at(x1, y1, 0), saturated(s));
     };
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
@@ -127,13 +130,13 @@ Image error_guide(const Image& color, const Image* halves_map) {
         // The squared map averaged over each 3×3 neighbourhood (zero outside the image).
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
-                float sum = 0.0f;
+                double sum = 0.0;
                 for (int v = std::max(0, y - 1); v <= std::min(h - 1, y + 1); ++v)
                     for (int u = std::max(0, x - 1); u <= std::min(w - 1, x + 1); ++u) {
-                        const float m = halves_map->at(u, v, 0);
+                        const double m = halves_map->at(u, v, 0);
                         sum += m * m;
                     }
-                g.at(x, y, 0) += sum / 9.0f;
+                g.at(x, y, 0) = saturated(g.at(x, y, 0) + sum / 9.0);
             }
     }
     return g;
