@@ -225,6 +225,10 @@ def test_orthographic_maps_world_units_linearly():
     "make, error, words",
     [
         (lambda: mr.Camera.look_at((0, 0, 1), (0, 0, 1)), ValueError, ["eye and target coincide"]),
+        # finite, but target - eye (or its cross product with up) overflows: was "up is parallel"
+        (lambda: mr.Camera.look_at((1e308, 0, 0), (-1e308, 0, 0)), ValueError, ["eye and target are too far apart"]),
+        (lambda: mr.Camera.look_at((0, 0, 1), (0, 0, 0), up=(1e308, 1e308, 0)), ValueError,
+         ["up and the view direction are too large"]),
         (lambda: mr.Camera.look_at((0, 0, 1), (0, 0, 0), up=(0, 0, 2)), ValueError, ["up", "parallel"]),
         (lambda: mr.Camera.look_at((0, 0, 1), (0, 0, 0), fov_y=180), ValueError, ["fov_y", "(0, 180)", "180"]),
         (lambda: mr.Camera.look_at((0, 0, 1), (0, 0, 0), fov_y=0), ValueError, ["fov_y"]),

@@ -267,6 +267,9 @@ def test_obj_coordinate_that_is_not_a_number_is_an_error(tmp_path):
     path.write_text("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n")
     with pytest.raises(OSError, match=r"line 2 \('v nan 0 0'\): 'nan' is not a finite number"):
         mr.load_scene(path)
+    path.write_text("v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n")  # finite, but not as a float
+    with pytest.raises(OSError, match=r"line 2 \('v 1e39 0 0'\): '1e39' is beyond float's range"):
+        mr.load_scene(path)
 
 
 @pytest.mark.parametrize("corner", ["4294967297", "99999999999999999999", "2147483648", "1/4294967297", "1//x"])

@@ -91,9 +91,9 @@ struct ObjGroup {
 };
 
 // tinyobjloader reads a coordinate it cannot parse ("nan", "inf", "1,5", "x") as 0, and a face
-// index beyond 32 bits wrapped around: a silently wrong mesh. Every number of the v / vt / vn lines
-// must parse completely and be finite, and every index of the f lines must be an integer that
-// fits an int (negative ones count back from the end).
+// index beyond 32 bits wrapped around: a silently wrong mesh. Every number of the v / vt / vn
+// lines must parse completely and be a finite float, and every index of the f lines must be an
+// integer that fits an int (negative ones count back from the end).
 void check_obj_numbers(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) fail(path, "cannot open OBJ file");
@@ -126,6 +126,8 @@ void check_obj_numbers(const std::string& path) {
             char* end = nullptr;
             const double value = std::strtod(word.c_str(), &end);
             if (end != word.c_str() + word.size() || !std::isfinite(value)) bad("'" + word + "' is not a finite number");
+            // (tinyobjloader keeps floats: 1e39 became inf, and the message named that instead.)
+            if (std::fabs(value) > std::numeric_limits<float>::max()) bad("'" + word + "' is beyond float's range");
         }
     }
 }

@@ -39,8 +39,13 @@ std::string to_string(DepthConvention c) { return c == DepthConvention::opengl ?
 
 glm::dmat4 look_at(const glm::dvec3& eye, const glm::dvec3& target, const glm::dvec3& up) {
     const glm::dvec3 w = target - eye;
+    // (Finite inputs can still overflow here: the cross product then held NaN, which read as
+    // "up is parallel".)
+    require(std::isfinite(glm::length(w)), "look_at: eye and target are too far apart (target - eye overflows)");
     require(glm::length(w) > 0.0, "look_at: eye and target coincide");
     const glm::dvec3 u = glm::cross(w, up);  // the seeds: u = w × y
+    require(std::isfinite(glm::length(u)),
+            "look_at: up and the view direction are too large (their cross product overflows)");
     require(glm::length(u) > 0.0, "look_at: up is parallel to the view direction");
     const glm::dvec3 v = glm::cross(u, w);
     const glm::dvec3 un = glm::normalize(u), vn = glm::normalize(v), wn = glm::normalize(w);
