@@ -165,6 +165,19 @@ def write_textured_gltf(path, image, sampler=None):
     return path
 
 
+@pytest.mark.parametrize("uri", [".", "sub", "/dev/zero", "missing.bin"])
+def test_gltf_buffer_that_is_not_a_readable_file_is_an_error_naming_it(tmp_path, uri):
+    # A directory was opened and its "size" allocated: std::bad_alloc.
+    (tmp_path / "sub").mkdir()
+    path = write_textured_gltf(tmp_path / "quad.gltf", {"uri": "missing.png"})
+    doc = json.loads(path.read_text())
+    doc["buffers"][0]["uri"] = uri
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=r"quad\.gltf: cannot read glTF: File not found : ") as e:
+        mr.load_scene(path)
+    assert f"File not found : {uri}:" in str(e.value)
+
+
 NEAREST_CLAMP = {"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33648}
 
 

@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -847,8 +848,17 @@ struct GltfLoader {
     }
 };
 
+// tinygltf's FileExists callback, for regular files only: a buffer whose uri named a directory
+// was opened and its "size" allocated (std::bad_alloc).
+bool regular_file_exists(const std::string& path, void*) {
+    std::error_code ec;
+    return std::filesystem::is_regular_file(path, ec);
+}
+
 LoadedScene load_gltf(const std::string& path, bool binary) {
     tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks({regular_file_exists, tinygltf::ExpandFilePath, tinygltf::ReadWholeFile,
+                           tinygltf::WriteWholeFile, nullptr});
     EmbeddedImages embedded;
     loader.SetImageLoader(keep_data_uri_image, &embedded);
     tinygltf::Model model;
