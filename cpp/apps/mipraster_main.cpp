@@ -155,6 +155,20 @@ int parse_int(const std::string& option, const std::string& text) {
     return static_cast<int>(value);
 }
 
+// A seed: any integer from 0 to 2^64 - 1, as the Python API takes.
+std::uint64_t parse_seed(const std::string& option, const std::string& text) {
+    std::size_t used = 0;
+    unsigned long long value = 0;
+    try {
+        if (!text.empty() && std::isdigit(static_cast<unsigned char>(text[0]))) value = std::stoull(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != text.size())
+        throw UsageError(option + ": expected an integer from 0 to 18446744073709551615, got '" + text + "'");
+    return value;
+}
+
 double parse_number(const std::string& option, const std::string& text) {
     std::size_t used = 0;
     double value = 0;
@@ -282,7 +296,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
         } else if (a == "--pattern") {
             o.settings.pattern = parse_pattern_kind(value());
         } else if (a == "--seed") {
-            o.settings.pattern_seed = static_cast<std::uint64_t>(parse_int(a, value()));
+            o.settings.pattern_seed = parse_seed(a, value());
         } else if (a == "--threads") {
             o.settings.threads = parse_int(a, value());
         } else if (a == "--memory-limit") {
@@ -520,11 +534,8 @@ int run_synthesize(const std::vector<std::string>& args) {
     SynthesisSettings settings;
     const ImageCommand o = parse_image_command("synthesize", args, kMaxSynthesisDimension, [&](const std::string& a, auto value) {
         if (a == "--window") settings.window = parse_int(a, value());
-        else if (a == "--seed") {
-            const int seed = parse_int(a, value());
-            if (seed < 0) throw UsageError("--seed: expected an integer >= 0, got " + std::to_string(seed));
-            settings.seed = static_cast<std::uint64_t>(seed);
-        } else if (a == "--epsilon") settings.epsilon = parse_number(a, value());
+        else if (a == "--seed") settings.seed = parse_seed(a, value());
+        else if (a == "--epsilon") settings.epsilon = parse_number(a, value());
         else if (a == "--periodic") settings.periodic_sample = true;
         else if (a == "--tileable") settings.tileable = true;
         else return false;

@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
+import mipraster as mr
+
 
 def _find_exe():
     if os.environ.get("MIPRASTER_EXE"):  # e.g. the sanitized build of .ci/sanitize
@@ -104,6 +106,8 @@ def test_exr_output_is_openexr(tmp_path):
         (["--debug-view", "lod"], ["lod", "mip-level"]),
         (["--derivatives", "numeric"], ["numeric", "quad"]),
         (["--lod-bias", "x"], ["--lod-bias"]),
+        (["--seed", "-1"], ["--seed", "from 0 to 18446744073709551615", "'-1'"]),  # (was taken as 2^64 - 1)
+        (["--seed", "18446744073709551616"], ["--seed", "'18446744073709551616'"]),
     ],
 )
 def test_bad_options_exit_2_naming_the_input(tmp_path, args, words):
@@ -112,6 +116,19 @@ def test_bad_options_exit_2_naming_the_input(tmp_path, args, words):
     for w in words:
         assert w in r.stderr
     assert not (tmp_path / "x.png").exists()
+
+
+def test_any_seed_below_2_to_the_64(tmp_path):
+    # --seed takes what render(seed=...) takes: any integer below 2^64 (-1 was taken as 2^64 - 1).
+    def stratified(name, seed):
+        out = tmp_path / name
+        r = run("render", "-o", str(out), "--size", "24x16", "--spp", "4", "--pattern", "stratified", "--seed", seed)
+        assert r.returncode == 0, r.stderr
+        return mr.read_image(out)
+
+    largest = stratified("a.exr", str(2**64 - 1))
+    assert np.array_equal(stratified("b.exr", str(2**64 - 1)), largest)
+    assert not np.array_equal(stratified("c.exr", "0"), largest)
 
 
 def test_missing_output_and_unknown_command():

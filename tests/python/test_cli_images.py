@@ -67,7 +67,7 @@ def test_render_resolve_filter(tmp_path):
     (["resize", "missing.png", "-o", "o.png", "--size", "4x4"], 1, "missing.png"),
     (["synthesize", "IN", "-o", "o.png", "--size", "8x8", "--window", "4"], 2, "--window: expected an odd size"),
     (["synthesize", "IN", "-o", "o.png", "--size", "8x8", "--window", "31"], 2, "--window 31: larger than the sample"),
-    (["synthesize", "IN", "-o", "o.png", "--size", "8x8", "--seed", "-3"], 2, "--seed: expected an integer >= 0"),
+    (["synthesize", "IN", "-o", "o.png", "--size", "8x8", "--seed", "-3"], 2, "--seed: expected an integer from 0 to 18446744073709551615, got '-3'"),
     (["synthesize", "IN", "-o", "o.png", "--size", "8x8", "--epsilon", "-1"], 2, "--epsilon"),
     (["synthesize", "IN", "-o", "o.png", "--size", "9000x8"], 2, "--size: 9000x8 is out of range"),
     (["synthesize", "IN", "-o", "o.png", "--size", "8x8", "--bogus"], 2, "synthesize: unknown option '--bogus'"),
