@@ -106,8 +106,9 @@ TEST(MemoryLimit, EstimateGrowsWithWhatTheRenderKeeps) {
     const std::uint64_t base = reported_bytes(refusal(draws, plain));
     // Keeping the samples adds the whole sample framebuffer: 200·100·16 samples × 20 bytes.
     EXPECT_EQ(reported_bytes(refusal(draws, kept)) - base, 200u * 100u * 16u * 20u);
-    // So does a resolve filter wider than a pixel; the error estimate adds its map (4 bytes a pixel).
-    EXPECT_EQ(reported_bytes(refusal(draws, wide)) - base, 200u * 100u * 16u * 20u);
+    // So does a resolve filter wider than a pixel, with its row sums (four doubles a sample); the
+    // error estimate adds its map (4 bytes a pixel).
+    EXPECT_EQ(reported_bytes(refusal(draws, wide)) - base, 200u * 100u * 16u * (20u + 32u));
     EXPECT_EQ(reported_bytes(refusal(draws, estimated)) - base, 200u * 100u * 4u);
     // Each further worker adds its tile buffers: 32² pixels × 16 samples × 24 bytes (colour,
     // depth and deferred shading's owner), or 20 without deferred shading.
