@@ -254,7 +254,8 @@ class Texture:
         TypeError: texels of another dtype (bool, int64, object, ...), or a flag that is not a bool.
         ValueError: a wrong shape, an empty or too large texture (more than
             ``MAX_TEXTURE_DIMENSION`` = 65536 texels per side or 8 GiB as RGBA float), a NaN or
-            infinite texel (named by index), ``srgb=True`` with float texels or ``premultiplied=True``
+            infinite texel, or one beyond ±1e32 once premultiplied (named by index; so that every
+            filter's sums stay finite), ``srgb=True`` with float texels or ``premultiplied=True``
             with integer texels.
     """
 

@@ -235,6 +235,28 @@ def test_premultiplying_into_overflow_is_refused_by_the_core():
         mr.Texture(np.array([[[3e38, 0, 0, 2]]], np.float32), name="big")
 
 
+def test_texels_beyond_the_filters_range_are_refused():
+    # A checker of ±1.7e38 gave infinity from the anisotropic and EWA sums (and NaN pixels):
+    # texel values are limited to ±1e32, and at that limit every filter's result stays finite
+    # and within the texels' range.
+    with pytest.raises(ValueError, match=r"texture 'big': texel \(1, 0\) channel 2 is 2e\+32; texel values must "
+                                         r"lie within ±1e\+32"):
+        mr.Texture(np.array([[[0, 0, 0, 1], [0, 0, 2e32, 1]]], np.float32), name="big")
+    limit = np.float32(1e32)
+    texels = np.ones((16, 16, 4), np.float32)
+    texels[..., :3] = limit
+    texels[(np.add.outer(np.arange(16), np.arange(16)) % 2) == 0, :3] = -limit
+    texture = mr.Texture(texels)
+    rng = np.random.default_rng(5)
+    uv = rng.uniform(-2, 2, (400, 2))
+    for name in ("nearest", "bilinear", "trilinear", "anisotropic", "ewa", "sat"):
+        for scale in (0.0, 0.01, 0.3, 3.0, 100.0):
+            d = rng.uniform(-scale, scale, (400, 4))
+            out = texture.sample(uv, duv_dx=d[:, :2], duv_dy=d[:, 2:], sampler=name)
+            assert np.isfinite(out).all(), (name, scale)
+            assert np.abs(out[:, :3]).max() <= limit * (1 + 1e-6), (name, scale)
+
+
 def test_flag_and_name_errors():
     codes = np.zeros((2, 2, 4), np.uint8)
     floats = np.zeros((2, 2, 4), np.float32)

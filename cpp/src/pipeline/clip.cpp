@@ -41,13 +41,6 @@ using Quad = __float128;  // (IEEE binary128 in software: 113-bit significands)
 using Quad = long double;
 #endif
 
-// Endpoints farther out than this many times the smaller |w| of the two: their distances from
-// the plane, in double, are off by up to 2^-53 of their size, which moves the crossing along the
-// edge by up to 2^-27 in x/w and y/w, 2^-12 px at the largest image. Beyond, the crossing is
-// recomputed in Quad (a triangle of 10^21 px covered nothing, one of 10^22 a quarter of its
-// pixels).
-constexpr double kWideCrossingRatio = 0x1p26;
-
 // The point where edge (a, b) crosses the plane, always computed from the endpoint nearer the
 // plane (on a tie, the lexicographically smaller) so that (a, b) and (b, a) give the same bits.
 // From the far endpoint, a crossing next to a vertex 10^20 behind the eye came out as the
@@ -78,11 +71,12 @@ ClipVertex intersect(const ClipPlane& plane, const ClipVertex& a, double da, con
             t = wa == wb ? Wide(0) : wa / (wa - wb);
             t = t < Wide(0) ? Wide(0) : (t > Wide(1) ? Wide(1) : t);
         }
+        const auto along = [&](double from, double to) {
+            return static_cast<double>(Wide(from) + t * (Wide(to) - Wide(from)));
+        };
         ClipVertex out;
-        for (int i = 0; i < 4; ++i)
-            out.position[i] = static_cast<double>(Wide(a.position[i]) + t * (Wide(b.position[i]) - Wide(a.position[i])));
-        for (int i = 0; i < 3; ++i)
-            out.weights[i] = static_cast<double>(Wide(a.weights[i]) + t * (Wide(b.weights[i]) - Wide(a.weights[i])));
+        for (int i = 0; i < 4; ++i) out.position[i] = along(a.position[i], b.position[i]);
+        for (int i = 0; i < 3; ++i) out.weights[i] = along(a.weights[i], b.weights[i]);
         return out;
     };
     return wide ? crossing(Quad(0)) : crossing(static_cast<long double>(0));

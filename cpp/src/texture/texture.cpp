@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <mutex>
 #include <stdexcept>
@@ -12,6 +13,7 @@
 #include <glm/vec3.hpp>
 
 #include "mipraster/core/colour.hpp"
+#include "mipraster/core/constants.hpp"
 #include "mipraster/core/memory_limit.hpp"
 
 namespace mipraster {
@@ -118,11 +120,17 @@ Texture::Texture(TextureLevel level0, std::string name) {
                                     " texels for a " + std::to_string(level0.width) + "x" +
                                     std::to_string(level0.height) + " level");
     for (std::size_t i = 0; i < level0.texels.size(); ++i)
-        for (int c = 0; c < 4; ++c)
-            if (!std::isfinite(level0.texels[i][c]))
-                throw std::invalid_argument("texture '" + name + "': texel (" + std::to_string(i % level0.width) +
-                                            ", " + std::to_string(i / level0.width) + ") channel " +
-                                            std::to_string(c) + " is not finite");
+        for (int c = 0; c < 4; ++c) {
+            const float v = level0.texels[i][c];
+            if (std::fabs(v) <= kMaxTexelMagnitude) continue;
+            char what[128] = " is not finite";
+            if (std::isfinite(v))
+                std::snprintf(what, sizeof what,
+                              " is %g; texel values must lie within ±%g so that the filters' sums stay finite",
+                              double(v), double(kMaxTexelMagnitude));
+            throw std::invalid_argument("texture '" + name + "': texel (" + std::to_string(i % level0.width) + ", " +
+                                        std::to_string(i / level0.width) + ") channel " + std::to_string(c) + what);
+        }
     data_ = std::make_shared<TextureData>();
     data_->level_count = mip_level_count(level0.width, level0.height);
     data_->base = std::move(level0);

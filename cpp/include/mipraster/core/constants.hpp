@@ -65,6 +65,20 @@ inline constexpr std::size_t kStreamedSetupBytes = std::size_t{8} << 20;
 /// is far above it; it matters only for degenerate user matrices).
 inline constexpr double kMinClipW = 1e-30;
 
+/// An edge whose endpoints lie farther out than this many times the smaller |w| of the two
+/// crosses a clip plane in binary128 (clip.cpp): their distances from the plane, in double, are
+/// off by up to 2⁻⁵³ of their size, which moves a long-double crossing by up to 2⁻²⁷ in x/w and
+/// y/w, 2⁻¹² px at the largest image (a triangle of 10²¹ px covered nothing before).
+inline constexpr double kWideCrossingRatio = 0x1p26;
+static_assert(kWideCrossingRatio * 0x1p-53 * kMaxDimension <= 0x1p-12, "crossings within 2^-12 px on the cheap path");
+
+/// Texel values (after premultiplying) must lie within ±kMaxTexelMagnitude: the filters' float
+/// sums then stay finite (a checker of ±1.7·10³⁸ gave infinity and NaN pixels). The largest are
+/// an EWA ellipse's taps (at most 256² of weight ≤ 1) and a line of up to 1,024 anisotropic probes
+/// summed as differences from the first (each ≤ 2 of the bound). Far beyond any real radiance.
+inline constexpr float kMaxTexelMagnitude = 1e32f;
+static_assert(double(kMaxTexelMagnitude) * 2.0 * 65536.0 < 3.4e38, "the filters' largest sums stay within float");
+
 /// A triangle about to be clipped counts as projecting to a line when its homogeneous 3×3
 /// determinant is within this many double epsilons of its permanent: the determinant's own
 /// rounding (two products and a difference per minor, three terms) stays below 4 of them, so only
