@@ -57,16 +57,13 @@ _check_cpu(_X86_LEVEL)  # before the compiled modules load: see _cpu.py
 from ._core import (  # noqa: E402
     MemoryLimitError,
     kept_buffer_bytes,
-    linear_to_srgb,
-    linear_to_srgb8,
     memory_limit,
     release_kept_buffers,
     set_memory_limit,
-    srgb_to_linear,
 )
 from .camera import Camera
 from .compare import CompareReport, compare
-from .image import read_image, to_srgb8, write_image
+from .image import linear_to_srgb, linear_to_srgb8, read_image, srgb_to_linear, to_srgb8, write_image
 from .mesh import Mesh
 from .primitives import Raster, interpolate, rasterize, resolve
 from .render import RenderResult, render

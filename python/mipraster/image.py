@@ -14,7 +14,7 @@ import numpy as np
 
 from . import _checks, _core
 
-__all__ = ["read_image", "write_image", "to_srgb8"]
+__all__ = ["read_image", "write_image", "to_srgb8", "srgb_to_linear", "linear_to_srgb", "linear_to_srgb8"]
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -101,3 +101,20 @@ def to_srgb8(image: Any) -> np.ndarray:
     """
     a = _float_image(image, "image")
     return _core.to_srgb8(np.ascontiguousarray(a, dtype=np.float32))
+
+
+# The sRGB transfer functions, element by element (a number gives a number, an array an array of
+# float32; uint8 for linear_to_srgb8). Checked here: the bindings read None as 0.
+def srgb_to_linear(encoded: Any) -> Any:
+    """sRGB-encoded values (0…1) to linear; TypeError for anything but real numbers."""
+    return _core.srgb_to_linear(_checks.real_array(encoded, "encoded"))
+
+
+def linear_to_srgb(linear: Any) -> Any:
+    """Linear values to sRGB-encoded ones (0…1); TypeError for anything but real numbers."""
+    return _core.linear_to_srgb(_checks.real_array(linear, "linear"))
+
+
+def linear_to_srgb8(linear: Any) -> Any:
+    """Linear values to sRGB8 codes (0…255, rounded); TypeError for anything but real numbers."""
+    return _core.linear_to_srgb8(_checks.real_array(linear, "linear"))

@@ -132,6 +132,13 @@ def test_to_srgb8_and_scalar_transfer_functions():
     assert mr.linear_to_srgb8(0.5) == 188
     np.testing.assert_allclose(mr.srgb_to_linear(mr.linear_to_srgb(np.linspace(0, 1, 11))), np.linspace(0, 1, 11),
                                atol=1e-6)
+    assert mr.linear_to_srgb(0.5) == pytest.approx(0.735357, abs=1e-6) and mr.srgb_to_linear(1) == 1.0
+    # (The bindings alone read None as 0.)
+    for function, name in ((mr.linear_to_srgb, "linear"), (mr.linear_to_srgb8, "linear"),
+                           (mr.srgb_to_linear, "encoded")):
+        for bad in (None, [None], "0.5", {}):
+            with pytest.raises(TypeError, match=name):
+                function(bad)
 
 
 # --- errors -----------------------------------------------------------------------------------------

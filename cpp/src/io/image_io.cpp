@@ -129,7 +129,8 @@ void check_read_size(int w, int h, int nch, const std::string& name) {
         throw std::runtime_error("read_image: '" + name + "' is too large (" + std::to_string(w) + "x" +
                                  std::to_string(h) + " pixels; at most " + std::to_string(kMaxReadPixels) + ")");
     check_memory(pixels * std::uint64_t(nch) * (sizeof(float) + 1) + pixels * 4 * sizeof(float),
-                 "reading '" + name + "' (" + std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(nch) + ")");
+                 "reading '" + name + "' (" + std::to_string(w) + "x" + std::to_string(h) + "x" +
+                     std::to_string(nch) + ")");
 }
 
 // OpenImageIO's GIF reader decodes the first frame into a canvas of the logical screen's size

@@ -10,8 +10,8 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -126,7 +126,8 @@ void check_obj_numbers(const std::string& path) {
         while (words >> word && word[0] != '#') {
             char* end = nullptr;
             const double value = std::strtod(word.c_str(), &end);
-            if (end != word.c_str() + word.size() || !std::isfinite(value)) bad("'" + word + "' is not a finite number");
+            if (end != word.c_str() + word.size() || !std::isfinite(value))
+                bad("'" + word + "' is not a finite number");
             // (tinyobjloader keeps floats: 1e39 became inf, and the message named that instead.)
             if (std::fabs(value) > std::numeric_limits<float>::max()) bad("'" + word + "' is beyond float's range");
         }

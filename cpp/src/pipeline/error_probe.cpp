@@ -110,7 +110,9 @@ Image error_guide(const Image& color, const Image* halves_map) {
     // The largest mean over R, G, B of (half the step)² to a neighbour. In double, kept at most
     // the largest float: in float, colours of 10²⁰ squared to infinity, and the probe's draw
     // probabilities (guide / total) became NaN.
-    const auto saturated = [](double v) { return static_cast<float>(std::min<double>(v, std::numeric_limits<float>::max())); };
+    const auto saturated = [](double v) {
+        return static_cast<float>(std::min<double>(v, std::numeric_limits<float>::max()));
+    };
     auto step = [&](int x0, int y0, int x1, int y1) {
         double s = 0.0;
         for (int c = 0; c < 3; ++c) {

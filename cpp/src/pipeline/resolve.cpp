@@ -203,7 +203,8 @@ void resolve_framebuffer(const Framebuffer& fb, const SamplePattern& pattern, Re
                 // (A filter with negative lobes can overshoot the largest sample: beyond float's
                 // range, the nearest float is its largest.)
                 constexpr double kMax = std::numeric_limits<float>::max();
-                for (int c = 0; c < 4; ++c) out.at(x, y, c) = static_cast<float>(std::clamp(acc[c] / total, -kMax, kMax));
+                for (int c = 0; c < 4; ++c)
+                    out.at(x, y, c) = static_cast<float>(std::clamp(acc[c] / total, -kMax, kMax));
             }
         }
     });
