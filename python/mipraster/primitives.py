@@ -181,11 +181,13 @@ def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str = "pe
         result = values[:, 0, :]
     else:
         b = raster.barycentrics[covered].astype(np.float64)
-        weights = np.stack([1.0 - b[:, 0] - b[:, 1], b[:, 0], b[:, 1]], axis=1)  # (M, 3)
+        # The stored weights are float32: b1 + b2 may round above 1, and the first weight below 0
+        # (values then left the vertex range: [1e6, 0, 0] gave -0.011). Kept convex.
+        weights = np.maximum(np.stack([1.0 - b[:, 0] - b[:, 1], b[:, 0], b[:, 1]], axis=1), 0.0)  # (M, 3)
         if mode == "screen":
             # Perspective-correct weights are (λ_i / w_i) normalized: λ_i ∝ weight_i · w_i.
             weights = weights * raster.w[corners]
-            weights /= weights.sum(axis=1, keepdims=True)
+        weights /= weights.sum(axis=1, keepdims=True)
         result = np.einsum("mi,mik->mk", weights, values)
 
     def scatter(per_sample: np.ndarray) -> np.ndarray:

@@ -107,6 +107,34 @@ def test_triangles_crossing_the_near_plane_keep_their_submitted_weights():
     assert np.abs(got - sample_positions(raster, W, H)[covered]).max() <= SNAP_PX
 
 
+@pytest.mark.parametrize("mode", ["perspective", "screen"])
+def test_interpolated_values_stay_within_the_vertex_values(mode):
+    # The raster's weights are float32, and two of them can sum above 1: with vertex values
+    # [1e6, 0, 0] the first vertex's weight 1 - b1 - b2 went negative and so did the values
+    # (-0.011 in this triangle; its w ranges over 10^7). Random triangles, one vertex value in turn
+    # large and the others 0: every covered sample within [0, value].
+    W = H = 32
+    w = np.array([5.53872139e03, 1.31114414e-04, 8.11186514e02])
+    screen = np.array([[-20.61096756124171, -17.911794228962865], [67.6179161557204, 63.42493842030686],
+                       [31.705749809553144, 34.13189048408914]])
+    ndc = np.stack([screen[:, 0] * 2 / W - 1, 1 - screen[:, 1] * 2 / H], 1)
+    tricky = np.stack([ndc[:, 0] * w, ndc[:, 1] * w, np.full(3, 1e-7), w], 1)
+    random, _ = random_scene(3, n=40)
+    drawn = 0
+    for pos in [tricky] + [random[3 * k:3 * k + 3] for k in range(40)]:
+        raster = mr.rasterize(pos, [[0, 1, 2]], W, H, spp=4)
+        covered = raster.triangle_id == 0
+        if not covered.any():
+            continue
+        drawn += 1
+        for corner in range(3):
+            values = np.zeros(3)
+            values[corner] = 1e6
+            got = mr.interpolate(values, raster, [[0, 1, 2]], mode=mode)[covered]
+            assert got.min() >= 0.0 and got.max() <= 1e6, (corner, got.min(), got.max())
+    assert drawn > 20
+
+
 def test_thread_counts_and_dtypes_give_identical_rasters():
     pos, tris = random_scene(4, n=400, size=0.3)
     a = mr.rasterize(pos, tris, 80, 60, spp=4, threads=1)
