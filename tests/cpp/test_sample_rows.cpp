@@ -195,7 +195,8 @@ bool random_row_triangle(std::mt19937_64& rng, int trial, mr::SetupTriangle& t) 
         const int px = static_cast<int>(rng() % 120) - 12, py = static_cast<int>(rng() % 104) - 12;
         const int jitter = trial % 2 ? static_cast<int>(rng() % 256) - 128 : 0;
         vertex = {static_cast<std::int32_t>(px * mr::kSubpixelOne + 128 + jitter),
-                  static_cast<std::int32_t>(py * mr::kSubpixelOne + 128 - jitter), 0.3 + 2.0 * unit(rng), unit(rng)};
+                  static_cast<std::int32_t>(py * mr::kSubpixelOne + 128 - jitter), 0.3 + 2.0 * unit(rng), unit(rng),
+                  0.0f, 0.0f};  // (on the grid already: not moved by snapping)
     }
     mr::SetupCounters counters;
     return mr::setup_triangle(v, viewport, mr::CullMode::none, t, counters);

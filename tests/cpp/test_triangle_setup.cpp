@@ -502,9 +502,12 @@ TEST(TriangleSetup, BackFaceCullingThroughAPerspectiveCameraKeepsTheFacesTowardT
 namespace {
 
 // The depth plane is kept in double and rounded to float once per sample, so the stored depth is
-// the correctly rounded screen-affine interpolation of the vertices' window depths (z/w). A plane
-// stored as three floats rounds three times and can invert surfaces ~1e-7 apart (relative):
-// found by the stress suite, case 5 (reverse-Z, distance 100, separation 1e-7: 80 % inverted).
+// the correctly rounded value of the unsnapped triangle's depth plane (screen-affine in z/w) at
+// the sample's position in the snapped triangle. A plane stored as three floats rounds three times
+// and can invert surfaces ~1e-7 apart (relative): found by the stress suite, case 5 (reverse-Z,
+// distance 100, separation 1e-7: 80 % inverted). The vertices' own depths interpolated over the
+// snapped triangle are off by the plane's change across the snapping: surfaces 1e-6 apart whose
+// vertices snapped differently swapped.
 TEST(TriangleSetup, DepthAtASampleIsTheCorrectlyRoundedPlaneValue) {
     std::mt19937_64 rng(61);
     std::uniform_real_distribution<double> xy(-0.9, 0.9), w(0.5, 3.0), z(0.0, 1.0), bary(0.0, 1.0);
@@ -524,6 +527,17 @@ TEST(TriangleSetup, DepthAtASampleIsTheCorrectlyRoundedPlaneValue) {
         mr::SetupTriangle t;
         mr::SetupCounters counters;
         if (!mr::setup_triangle(p, vp, mr::CullMode::none, t, counters)) continue;
+        // Unsnapped (exact) and snapped positions in 1/256 px, and the exact plane's gradient.
+        long double ux[3], uy[3], sx[3], sy[3];
+        for (int i = 0; i < 3; ++i) {
+            ux[i] = (static_cast<long double>(p[i].x) / p[i].w + 1) * 128 * 256;
+            uy[i] = (1 - static_cast<long double>(p[i].y) / p[i].w) * 128 * 256;
+            const mr::ScreenVertex s = mr::project_vertex(p[i], vp);
+            sx[i] = s.x, sy[i] = s.y;
+        }
+        const long double ex1 = ux[1] - ux[0], ey1 = uy[1] - uy[0], ex2 = ux[2] - ux[0], ey2 = uy[2] - uy[0];
+        const long double det = ex1 * ey2 - ey1 * ex2, dz1 = zw[1] - zw[0], dz2 = zw[2] - zw[0];
+        const long double gx = (dz1 * ey2 - dz2 * ey1) / det, gy = (dz2 * ex1 - dz1 * ex2) / det;
         for (int j = 0; j < 8; ++j) {
             double l1 = bary(rng), l2 = bary(rng);
             if (l1 + l2 > 1.0) {
@@ -531,10 +545,12 @@ TEST(TriangleSetup, DepthAtASampleIsTheCorrectlyRoundedPlaneValue) {
                 l2 = 1.0 - l2;
             }
             const glm::dvec3 l(1.0 - l1 - l2, l1, l2);
-            const double exact = zw[0] + l1 * (zw[1] - zw[0]) + l2 * (zw[2] - zw[0]);
+            const long double x = l.x * sx[0] + l.y * sx[1] + l.z * sx[2], y = l.x * sy[0] + l.y * sy[1] + l.z * sy[2];
+            const double exact = static_cast<double>(zw[0] + gx * (x - ux[0]) + gy * (y - uy[0]));
             const float got = mr::sample_depth(t, l);
-            // Skip values within 1e-12 of a rounding boundary (double's own error could flip them).
-            const float lo = static_cast<float>(exact * (1 - 1e-12)), hi = static_cast<float>(exact * (1 + 1e-12));
+            // Skip values within 1e-9 of a rounding boundary (the snap offsets are kept as floats,
+            // 2^-25 of 1/256 px; with double's own error that could flip them).
+            const float lo = static_cast<float>(exact * (1 - 1e-9)), hi = static_cast<float>(exact * (1 + 1e-9));
             if (lo != hi) continue;
             ++checked;
             wrong += got != static_cast<float>(exact);

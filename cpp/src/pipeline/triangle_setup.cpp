@@ -78,10 +78,30 @@ bool setup_triangle(const std::array<ScreenVertex, 3>& v, const Viewport& viewpo
     out.max_y = static_cast<std::int32_t>(max_y);
     out.inv_area2 = 1.0 / static_cast<double>(sign * area2);
 
-    // Step 5: depth (affine in screen space) and 1/w planes.
-    out.z0 = v[0].depth;
-    out.dz1 = v[1].depth - v[0].depth;
-    out.dz2 = v[2].depth - v[0].depth;
+    // Step 5: depth (affine in screen space) and 1/w planes. Depth is interpolated over the snapped
+    // triangle from a value at each vertex: its depth moved along the depth plane to where the
+    // vertex snapped, so that every sample's depth is the unsnapped plane's there (up to
+    // rounding). From the vertices' own depths, two surfaces 10⁻⁶ apart whose vertices snapped to
+    // different points could swap. The gradient is the unsnapped triangle's; a shift is at most the
+    // triangle's depth range (only a near-degenerate unsnapped triangle would go beyond).
+    double z[3] = {v[0].depth, v[1].depth, v[2].depth};
+    {
+        double px[3], py[3];  // the unsnapped positions, in 1/256 px
+        for (int i = 0; i < 3; ++i) px[i] = double(X[i]) - v[i].snap_x, py[i] = double(Y[i]) - v[i].snap_y;
+        const double ex1 = px[1] - px[0], ey1 = py[1] - py[0], ex2 = px[2] - px[0], ey2 = py[2] - py[0];
+        const double dz1 = z[1] - z[0], dz2 = z[2] - z[0], inverse = 1.0 / (ex1 * ey2 - ey1 * ex2);
+        // ∂z/∂x and ∂z/∂y per 1/256 px:
+        const double gx = (dz1 * ey2 - dz2 * ey1) * inverse, gy = (dz2 * ex1 - dz1 * ex2) * inverse;
+        const double range = std::max({z[0], z[1], z[2]}) - std::min({z[0], z[1], z[2]});
+        for (int i = 0; i < 3; ++i) {
+            const double shift = gx * v[i].snap_x + gy * v[i].snap_y;
+            // (0: the same bits; not finite: an unsnapped triangle of no area, left as it is)
+            if (shift != 0.0 && std::isfinite(shift)) z[i] += std::clamp(shift, -range, range);
+        }
+    }
+    out.z0 = z[0];
+    out.dz1 = z[1] - z[0];
+    out.dz2 = z[2] - z[0];
     // 1/w enters only ratios (perspective weights, uv and its derivatives), so the three values are
     // scaled by the power of two that brings the largest to [1, 2). That is exact: where 1/w fits a
     // float nothing changes, and where it does not the values stay in range (a camera matrix scaled

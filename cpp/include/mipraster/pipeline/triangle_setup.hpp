@@ -43,19 +43,20 @@ struct Viewport {
     DepthConvention depth_convention = DepthConvention::reverse_z;
 };
 
-/// A clip-space vertex on the screen: its position snapped to 1/256 px (y down), its window depth
-/// and 1/w. Not valid (inv_w = 0) when a projected coordinate is not finite or beyond
-/// kMaxFixedCoordinate, or 1/w is not a positive normal double; the other fields are then
-/// meaningless. (24 bytes: setup reads three per triangle. No default values: a frame's array of
-/// them is sized, then written only where a vertex is inside the clip volume; ScreenVertex{} is
-/// all zeros.)
+/// A clip-space vertex on the screen: its position snapped to 1/256 px (y down), how far the
+/// snapping moved it (in 1/256 px, within ±½), its window depth at the unsnapped position and 1/w.
+/// Not valid (inv_w = 0) when a projected coordinate is not finite or beyond kMaxFixedCoordinate,
+/// or 1/w is not a positive normal double; the other fields are then meaningless. (32 bytes: setup
+/// reads three per triangle. No default values: a frame's array of them is sized, then written
+/// only where a vertex is inside the clip volume; ScreenVertex{} is all zeros.)
 struct ScreenVertex {
     std::int32_t x, y;
     double inv_w;
     double depth;
+    float snap_x, snap_y;  // snapped − unsnapped position
     bool valid() const { return inv_w > 0.0; }
 };
-static_assert(sizeof(ScreenVertex) == 24);
+static_assert(sizeof(ScreenVertex) == 32);
 
 /// Projects and snaps one clip-space vertex. A vertex shared by several triangles is projected
 /// once: the result is the same whichever triangle asks. (Inline: returned through memory, the
@@ -66,8 +67,8 @@ inline ScreenVertex project_vertex(const glm::dvec4& p, const Viewport& viewport
     const double half_w = 0.5 * viewport.width, half_h = 0.5 * viewport.height;
     const double limit = static_cast<double>(kMaxFixedCoordinate);
     const double inv_w = 1.0 / p.w;
-    const double xs = std::nearbyint((p.x * inv_w + 1.0) * half_w * kSubpixelOne);
-    const double ys = std::nearbyint((1.0 - p.y * inv_w) * half_h * kSubpixelOne);
+    const double x = (p.x * inv_w + 1.0) * half_w * kSubpixelOne, y = (1.0 - p.y * inv_w) * half_h * kSubpixelOne;
+    const double xs = std::nearbyint(x), ys = std::nearbyint(y);
     const double z = p.z * inv_w;
     ScreenVertex v{};
     v.depth = viewport.depth_convention == DepthConvention::opengl ? 0.5 * z + 0.5 : z;
@@ -78,6 +79,8 @@ inline ScreenVertex project_vertex(const glm::dvec4& p, const Viewport& viewport
         return v;
     v.x = static_cast<std::int32_t>(xs);
     v.y = static_cast<std::int32_t>(ys);
+    v.snap_x = static_cast<float>(xs - x);
+    v.snap_y = static_cast<float>(ys - y);
     v.inv_w = inv_w;
     return v;
 }
