@@ -58,19 +58,16 @@ ClipVertex intersect(const ClipPlane& plane, const ClipVertex& a, double da, con
     const bool wide = !(size <= kWideCrossingRatio * std::min(std::fabs(a.position.w), std::fabs(b.position.w)));
     const auto crossing = [&](auto wide_zero) {
         using Wide = decltype(wide_zero);
-        Wide t = Wide(da) / (Wide(da) - Wide(db));
-        if (wide) {
-            const auto distance = [&](const glm::dvec4& p) {
-                Wide d = Wide(plane.offset);
-                for (int i = 0; i < 4; ++i) d += Wide(plane.normal[i]) * Wide(p[i]);
-                return d;
-            };
-            const Wide wa = distance(a.position), wb = distance(b.position);
-            // (The double distances chose the edge; in Quad the crossing may land a hair beyond
-            // an endpoint, or their difference be 0: kept on the edge.)
-            t = wa == wb ? Wide(0) : wa / (wa - wb);
-            t = t < Wide(0) ? Wide(0) : (t > Wide(1) ? Wide(1) : t);
-        }
+        const auto distance = [&](const glm::dvec4& p) {
+            Wide d = Wide(plane.offset);
+            for (int i = 0; i < 4; ++i) d += Wide(plane.normal[i]) * Wide(p[i]);
+            return d;
+        };
+        // The edge's parameter from the double distances, or in Quad from the distances again.
+        // (The double distances chose the edge; in Quad the crossing may land a hair beyond an
+        // endpoint, or their difference be 0: kept on the edge.)
+        const Wide wa = wide ? distance(a.position) : Wide(da), wb = wide ? distance(b.position) : Wide(db);
+        const Wide t = !wide ? wa / (wa - wb) : wa == wb ? Wide(0) : std::clamp(wa / (wa - wb), Wide(0), Wide(1));
         const auto along = [&](double from, double to) {
             return static_cast<double>(Wide(from) + t * (Wide(to) - Wide(from)));
         };
