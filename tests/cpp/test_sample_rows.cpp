@@ -18,7 +18,8 @@
 
 #include "helpers.hpp"
 #include "mipraster/pipeline/interpolate.hpp"
-#include "pipeline/sample_row.hpp"  // (internal: the two vector widths side by side)
+#include "pipeline/pixel_samples.hpp"  // (internal: coverage masks four samples per vector)
+#include "pipeline/sample_row.hpp"     // (internal: the two vector widths side by side)
 
 namespace {
 
@@ -409,6 +410,57 @@ TEST(SampleRows, PixelRowsGiveThePerSampleArithmeticOnRandomRows) {
     EXPECT_GE(rows, 15000);
     EXPECT_GE(on_edges, 200);
     EXPECT_GE(passed_samples, 50000);
+}
+
+// pixel_coverage_avx2 (MSAA and SSAA rows' coverage masks, four samples per vector) against the
+// exact per-sample test: all three integer edge values ≥ 0. Rows start left of the triangle and
+// run past it; sample 0 is the pixel centre, through which half the triangles' edges run, so
+// edge values of exactly 0 (inside by the top-left bias) and −1 (outside) are common.
+TEST(SampleRows, CoverageMasksFourSamplesPerVectorAreTheExactPerSampleTest) {
+    if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2, which pixel_coverage_avx2 needs";
+    std::mt19937_64 rng(63);
+    long rows = 0, on_edges = 0, inside = 0, outside = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        mr::SetupTriangle t;
+        if (!random_row_triangle(rng, trial, t)) continue;
+        const int S = std::array<int, 4>{4, 4, 8, 16}[trial % 4];
+        std::int64_t off[3][16];
+        for (int s = 0; s < S; ++s) {
+            const std::int64_t ox = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
+            const std::int64_t oy = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
+            for (int i = 0; i < 3; ++i) off[i][s] = std::int64_t{t.edge_a[i]} * ox + std::int64_t{t.edge_b[i]} * oy;
+        }
+        const int y = t.min_y + static_cast<int>(rng() % static_cast<unsigned>(t.max_y - t.min_y + 1));
+        const int x0 = t.min_x - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_x - t.min_x + 3));
+        const int n = 1 + static_cast<int>(rng() % mr::kTileSize);
+        std::int64_t corner[3], step[3];
+        const std::int64_t X = std::int64_t{x0} * mr::kSubpixelOne, Y = std::int64_t{y} * mr::kSubpixelOne;
+        for (int i = 0; i < 3; ++i) {
+            corner[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+            step[i] = std::int64_t{t.edge_a[i]} * mr::kSubpixelOne;
+        }
+        std::uint64_t mask[mr::kTileSize];
+        mr::kernels::pixel_coverage_avx2(corner, {off[0], off[1], off[2]}, step, n, S, mask);
+        for (int j = 0; j < n; ++j) {
+            std::uint64_t want = 0;
+            for (int s = 0; s < S; ++s) {
+                std::int64_t E[3];
+                for (int i = 0; i < 3; ++i) E[i] = corner[i] + j * step[i] + off[i][s];
+                on_edges += E[0] == 0 || E[1] == 0 || E[2] == 0;
+                if (E[0] >= 0 && E[1] >= 0 && E[2] >= 0) want |= std::uint64_t{1} << s;
+            }
+            ASSERT_EQ(mask[j], want) << "trial " << trial << " pixel " << j << " of " << n << ", " << S << " samples";
+            inside += __builtin_popcountll(want);
+            outside += S - __builtin_popcountll(want);
+        }
+        ++rows;
+    }
+    std::cout << "rows " << rows << ", samples on an edge " << on_edges << ", inside " << inside << ", outside "
+              << outside << "\n";
+    EXPECT_GE(rows, 15000);
+    EXPECT_GE(on_edges, 200);
+    EXPECT_GE(inside, 50000);
+    EXPECT_GE(outside, 50000);
 }
 
 }  // namespace
