@@ -4,6 +4,7 @@ import base64
 import json
 import math
 import os
+import re
 import struct
 import subprocess
 import warnings
@@ -322,3 +323,154 @@ def test_scene_file_renders_are_deterministic(tmp_path):
         assert r.returncode == 0, r.stderr
         outs.append(out.read_bytes())
     assert outs[0] == outs[1]
+
+
+# --- glTF as found in the wild: strips and fans, sparse accessors, texCoord sets, texture transforms,
+# required extensions. Each file is compared with an independent oracle: the same surface written in
+# the plain form the loader already read (TRIANGLES, dense accessors, TEXCOORD_0, uvs transformed here).
+
+def data_uri(data):
+    return "data:application/octet-stream;base64," + base64.b64encode(data).decode()
+
+
+def write_mesh_gltf(path, chunks, accessors, primitives, materials=None, extra=None, camera_z=5.0, meshes=None,
+                    nodes=None):
+    """A glTF file whose buffer is `chunks` (one bufferView each, 4-byte aligned), with `accessors`,
+    one mesh of `primitives` (or `meshes`) on node 0 (or `nodes`) and an orthographic camera on the z axis
+    at `camera_z` looking at the origin, seeing [-1, 1]^2; `extra` is merged into the document."""
+    buf, views = b"", []
+    for chunk in chunks:
+        views.append({"buffer": 0, "byteOffset": len(buf), "byteLength": len(chunk)})
+        buf += chunk + b"\0" * (-len(chunk) % 4)
+    # A camera at -z looks back at the origin: rotated half a turn about y.
+    cam_node = {"camera": 0, "translation": [0, 0, camera_z]}
+    if camera_z < 0:
+        cam_node["rotation"] = [0, 1, 0, 0]
+    nodes = nodes if nodes is not None else [{"mesh": 0}]
+    doc = {
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": list(range(len(nodes) + 1))}],
+        "nodes": nodes + [cam_node],
+        "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}],
+        "meshes": meshes if meshes is not None else [{"primitives": primitives}],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": len(buf), "uri": data_uri(buf)}],
+    }
+    if materials is not None:
+        doc["materials"] = materials
+    doc.update(extra or {})
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def vec_accessor(view, count, kind="VEC3", component=5126, **more):
+    return {"bufferView": view, "componentType": component, "count": count, "type": kind, **more}
+
+
+def load_warning_texts(path):
+    """mr.load_scene(path) and the texts of the warnings it gave."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        scene, cameras = mr.load_scene(path)
+    return scene, [str(w.message) for w in caught]
+
+
+def render_color(path, size=48):
+    """The colour render (one sample per pixel) of a file through its camera."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a file the loader reads fully gives no warning
+        scene, cameras = mr.load_scene(path)
+    return mr.render(scene, cameras[0], size, size).color, scene
+
+
+# A zigzag ribbon in z = 0: with the spec's strip winding every triangle is counter-clockwise seen
+# from +z (front-facing for the camera on +z).
+STRIP = np.float32([[-0.9, 0.5, 0], [-0.9, -0.5, 0], [-0.3, 0.6, 0], [-0.3, -0.4, 0],
+                    [0.3, 0.5, 0], [0.3, -0.6, 0], [0.9, 0.4, 0]])
+# A fan: the centre, then rim points counter-clockwise seen from +z.
+FAN = np.float32([[0, 0, 0], [0.8, 0, 0], [0.5, 0.6, 0], [0, 0.9, 0], [-0.6, 0.5, 0], [-0.8, -0.2, 0],
+                  [0, -0.8, 0]])
+
+
+def vertex_colors(n):
+    rng = np.random.default_rng(n)
+    return np.float32(rng.uniform(0.1, 1.0, (n, 4)))
+
+
+def spec_triangles(mode, sequence):
+    """glTF 2.0 §3.7.2.1, written out here as the oracle: strip triangle i is
+    (v[i], v[i + (1 + i % 2)], v[i + (2 - i % 2)]), fan triangle i is (v[i + 1], v[i + 2], v[0])."""
+    n = len(sequence)
+    if mode == 5:
+        return [(sequence[i], sequence[i + 1 + i % 2], sequence[i + 2 - i % 2]) for i in range(n - 2)]
+    return [(sequence[i + 1], sequence[i + 2], sequence[0]) for i in range(n - 2)]
+
+
+def write_assembled(path, mode, positions, indices=None, double_sided=False, camera_z=5.0):
+    """`positions` (and COLOR_0) drawn as one primitive of `mode`, indexed when `indices` is given."""
+    n = len(positions)
+    chunks = [positions.tobytes(), vertex_colors(n).tobytes()]
+    accessors = [vec_accessor(0, n), vec_accessor(1, n, "VEC4")]
+    prim = {"attributes": {"POSITION": 0, "COLOR_0": 1}, "mode": mode, "material": 0}
+    if indices is not None:
+        chunks.append(np.uint16(indices).tobytes())
+        accessors.append(vec_accessor(2, len(indices), "SCALAR", 5123))
+        prim["indices"] = 2
+    materials = [{"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1]}, "doubleSided": double_sided}]
+    return write_mesh_gltf(path, chunks, accessors, [prim], materials, camera_z=camera_z)
+
+
+@pytest.mark.parametrize("mode, positions", [(5, STRIP), (6, FAN)], ids=["strip", "fan"])
+@pytest.mark.parametrize("indexed", [False, True])
+def test_gltf_strips_and_fans_render_as_their_spec_triangles(tmp_path, mode, positions, indexed):
+    n = len(positions)
+    # Indexed: the vertices stored in a shuffled order, the index list putting them back.
+    order = np.random.default_rng(3).permutation(n) if indexed else np.arange(n)
+    stored = positions[order] if indexed else positions
+    sequence = [int(np.flatnonzero(order == v)[0]) for v in range(n)] if indexed else list(range(n))
+    path = write_assembled(tmp_path / "assembled.gltf", mode, stored, sequence if indexed else None)
+    # The oracle: the same vertex buffer (and colours) drawn as TRIANGLES with the spec's index list.
+    triangles = [v for tri in spec_triangles(mode, sequence) for v in tri]
+    oracle = write_assembled(tmp_path / "triangles.gltf", 4, stored, triangles)
+    got, scene = render_color(path)
+    want, oracle_scene = render_color(oracle)
+    np.testing.assert_array_equal(scene.draws[0].mesh.triangles, oracle_scene.draws[0].mesh.triangles)
+    assert np.array_equal(got, want)
+    assert (got[..., 3] > 0).sum() > 0.3 * got.shape[0] * got.shape[1]  # a real picture
+
+
+@pytest.mark.parametrize("mode, positions", [(5, STRIP), (6, FAN)], ids=["strip", "fan"])
+def test_gltf_single_sided_strip_and_fan_draw_every_triangle_from_the_front_only(tmp_path, mode, positions):
+    # Culling is the independent check of the winding: seen from the front every triangle draws
+    # (a strip whose odd triangles kept the stored order would lose them to back-face culling), and
+    # seen from behind none does.
+    size = 64
+    front, scene = render_color(write_assembled(tmp_path / "front.gltf", mode, positions), size)
+    back, _ = render_color(write_assembled(tmp_path / "back.gltf", mode, positions, camera_z=-5.0), size)
+    assert len(scene.draws[0].mesh.triangles) == len(positions) - 2
+    for tri in spec_triangles(mode, list(range(len(positions)))):
+        x, y = positions[list(tri), :2].mean(axis=0)
+        # The orthographic camera sees [-1, 1]^2: column (x + 1) / 2 * size, row (1 - y) / 2 * size.
+        col, row = int((x + 1) / 2 * size), int((1 - y) / 2 * size)
+        assert front[row, col, 3] == 1.0, (tri, row, col)
+    assert (back[..., 3] == 0).all()
+
+
+@pytest.mark.parametrize("mode", [5, 6])
+@pytest.mark.parametrize("indexed", [False, True])
+def test_gltf_strip_or_fan_of_fewer_than_three_vertices_warns(tmp_path, mode, indexed):
+    positions = STRIP[:2]
+    path = write_assembled(tmp_path / "short.gltf", mode, positions, [0, 1] if indexed else None)
+    scene, texts = load_warning_texts(path)
+    assert any(re.search(r"meshes\[0\]\.primitives\[0\]: a triangle (strip|fan) of 2 vertices has no triangle", t)
+               for t in texts), texts
+    assert len(scene.draws[0].mesh.triangles) == 0
+
+
+@pytest.mark.parametrize("mode", [0, 1, 2, 3])
+def test_gltf_points_and_lines_stay_skipped_with_a_warning(tmp_path, mode):
+    path = write_assembled(tmp_path / "lines.gltf", mode, STRIP)
+    scene, texts = load_warning_texts(path)
+    assert any(re.search(r"skipped 1 primitive\(s\) of mode POINTS or LINES", t) for t in texts), texts
+    assert scene.draws == [] or all(len(d.mesh.triangles) == 0 for d in scene.draws)

@@ -468,6 +468,13 @@ glm::dmat4 node_matrix(const tinygltf::Node& node, const std::string& path, int 
     return t * r * s;
 }
 
+/// Whether a primitive mode is one of triangles (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN; −1: not
+/// given, TRIANGLES) rather than POINTS, LINES, LINE_LOOP, LINE_STRIP or a value glTF does not define.
+bool draws_triangles(int mode) {
+    return mode == -1 || mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
+           mode == TINYGLTF_MODE_TRIANGLE_FAN;
+}
+
 struct GltfLoader {
     const tinygltf::Model& model;
     const std::string& path;
@@ -672,6 +679,60 @@ struct GltfLoader {
                model.materials[material].alphaMode == "BLEND";
     }
 
+    /// The primitive's vertices in drawing order: its indices (any unsigned component type, each
+    /// checked against the vertex count), or 0, 1, …, vertex_count − 1 when it has none.
+    std::vector<std::uint32_t> vertex_sequence(const tinygltf::Primitive& prim, std::size_t vertex_count,
+                                               const std::string& what) const {
+        std::vector<std::uint32_t> sequence;
+        if (prim.indices < 0) {
+            sequence.resize(vertex_count);
+            for (std::size_t i = 0; i < vertex_count; ++i) sequence[i] = static_cast<std::uint32_t>(i);
+            return sequence;
+        }
+        const AccessorReader idx(model, prim.indices, path, what + " indices");
+        if (idx.components() != 1) fail(path, idx.what() + ": indices must be SCALAR");
+        sequence.resize(idx.count());
+        for (std::size_t i = 0; i < idx.count(); ++i) {
+            const std::uint64_t v = idx.get_index(i);
+            if (v >= vertex_count)
+                fail(path, idx.what() + ": index " + std::to_string(v) + " (element " + std::to_string(i) +
+                               ") is out of range (" + std::to_string(vertex_count) + " vertices)");
+            sequence[i] = static_cast<std::uint32_t>(v);
+        }
+        return sequence;
+    }
+
+    /// The triangles of a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN vertex sequence v, in the order
+    /// of the glTF 2.0 spec (§3.7.2.1): strip triangle i is (v[i], v[i+1+i%2], v[i+2−i%2]), i.e. odd
+    /// triangles swap their last two vertices so that all keep the strip's winding (back-face
+    /// culling depends on it); fan triangle i is (v[i+1], v[i+2], v[0]). Leftover vertices (a
+    /// TRIANGLES count that is no multiple of 3) and strips or fans of fewer than 3 vertices give
+    /// a warning.
+    std::vector<glm::uvec3> assemble_triangles(int mode, const std::vector<std::uint32_t>& v,
+                                               const std::string& what) {
+        const std::size_t n = v.size();
+        std::vector<glm::uvec3> triangles;
+        if (mode == TINYGLTF_MODE_TRIANGLES || mode == -1) {
+            if (n % 3 != 0)
+                scene.warnings.push_back(path + ": " + what + ": vertex count " + std::to_string(n) +
+                                         " is not a multiple of 3; the last vertices are ignored");
+            triangles.resize(n / 3);
+            for (std::size_t t = 0; t < triangles.size(); ++t) triangles[t] = {v[3 * t], v[3 * t + 1], v[3 * t + 2]};
+            return triangles;
+        }
+        const bool strip = mode == TINYGLTF_MODE_TRIANGLE_STRIP;
+        if (n < 3) {
+            scene.warnings.push_back(path + ": " + what + ": a triangle " + (strip ? "strip" : "fan") + " of " +
+                                     std::to_string(n) + " vertices has no triangle");
+            return triangles;
+        }
+        triangles.resize(n - 2);
+        for (std::size_t i = 0; i < n - 2; ++i)
+            triangles[i] = strip ? glm::uvec3(v[i], v[i + 1 + i % 2], v[i + 2 - i % 2])
+                                 : glm::uvec3(v[i + 1], v[i + 2], v[0]);
+        return triangles;
+    }
+
     std::shared_ptr<Mesh> primitive_mesh(int mesh_index, int prim_index) {
         const auto key = std::make_pair(mesh_index, prim_index);
         if (auto it = mesh_cache.find(key); it != mesh_cache.end()) return it->second;
@@ -743,27 +804,8 @@ struct GltfLoader {
                 mesh->normals[i] = glm::vec3(nrm.get(i, 0), nrm.get(i, 1), nrm.get(i, 2));
         }
 
-        // Indices (any unsigned component type), or the vertices in order.
-        if (prim.indices >= 0) {
-            const AccessorReader idx(model, prim.indices, path, what + " indices");
-            if (idx.components() != 1) fail(path, idx.what() + ": indices must be SCALAR");
-            if (idx.count() % 3 != 0)
-                scene.warnings.push_back(path + ": " + what + ": index count " + std::to_string(idx.count()) +
-                                         " is not a multiple of 3; the last indices are ignored");
-            mesh->triangles.resize(idx.count() / 3);
-            for (std::size_t t = 0; t < mesh->triangles.size(); ++t)
-                for (int c = 0; c < 3; ++c) {
-                    const std::uint64_t v = idx.get_index(3 * t + c);
-                    if (v >= pos.count())
-                        fail(path, idx.what() + ": index " + std::to_string(v) + " of triangle " + std::to_string(t) +
-                                       " is out of range (" + std::to_string(pos.count()) + " vertices)");
-                    mesh->triangles[t][c] = static_cast<std::uint32_t>(v);
-                }
-        } else {
-            mesh->triangles.resize(pos.count() / 3);
-            for (std::size_t t = 0; t < mesh->triangles.size(); ++t)
-                mesh->triangles[t] = glm::uvec3(3 * t, 3 * t + 1, 3 * t + 2);
-        }
+        // Triangles: the vertex sequence (the indices, or the vertices in order) assembled by mode.
+        mesh->triangles = assemble_triangles(prim.mode, vertex_sequence(prim, pos.count(), what), what);
         mesh->validate(path + " " + what);
         scene.meshes.push_back(mesh);
         mesh_cache.emplace(key, mesh);
@@ -790,7 +832,7 @@ struct GltfLoader {
             const tinygltf::Mesh& m = model.meshes[node.mesh];
             for (std::size_t p = 0; p < m.primitives.size(); ++p) {
                 const tinygltf::Primitive& prim = m.primitives[p];
-                if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) {
+                if (!draws_triangles(prim.mode)) {
                     ++skipped_primitives;
                     continue;
                 }
@@ -903,7 +945,8 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
     for (int r : roots) g.add_node(r, glm::dmat4(1.0), 0);
     if (g.skipped_primitives)
         g.scene.warnings.push_back(path + ": skipped " + std::to_string(g.skipped_primitives) +
-                                   " primitive(s) whose mode is not TRIANGLES");
+                                   " primitive(s) of mode POINTS or LINES, or of an unknown mode (only triangles "
+                                   "are drawn)");
     return std::move(g.scene);
 }
 

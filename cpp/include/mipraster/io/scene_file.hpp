@@ -72,9 +72,11 @@ struct LoadedScene {
 ///    OBJ has no cameras.
 ///  - `.gltf` (JSON with external or data-URI buffers and images) and `.glb` (binary, images in
 ///    bufferViews too): the default scene (else scene 0, else every root node); every node's
-///    mesh primitives of mode TRIANGLES (others are skipped with a warning) with any index
-///    component type, POSITION, COLOR_0 (vec3/vec4; float or normalized unsigned byte/short, all
-///    linear; vec4 is premultiplied), TEXCOORD_0 (vec2; float or normalized unsigned byte/short)
+///    mesh primitives of mode TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN (strips and fans become
+///    triangles in the glTF spec's order, which keeps their winding for culling; fewer than 3
+///    vertices give none and a warning; points and lines are skipped with a warning), indexed
+///    with any index component type or not, POSITION, COLOR_0 (vec3/vec4; float or normalized
+///    unsigned byte/short, all linear; vec4 is premultiplied), TEXCOORD_0 (vec2; float or normalized unsigned byte/short)
 ///    as uvs and NORMAL (vec3; float or normalized byte/short) as normals, drawn with the node's
 ///    world matrix (matrix or TRS, composed down the hierarchy); material baseColorFactor as the
 ///    draw colour (linear RGBA; alphaMode BLEND blends "over" with the colour premultiplied by its
