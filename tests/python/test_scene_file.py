@@ -474,3 +474,97 @@ def test_gltf_points_and_lines_stay_skipped_with_a_warning(tmp_path, mode):
     scene, texts = load_warning_texts(path)
     assert any(re.search(r"skipped 1 primitive\(s\) of mode POINTS or LINES", t) for t in texts), texts
     assert scene.draws == [] or all(len(d.mesh.triangles) == 0 for d in scene.draws)
+
+
+# Sparse accessors (glTF 2.0 §3.6.2.3).
+
+QUAD = np.float32([[-0.8, 0.8, 0], [0.8, 0.8, 0], [0.8, -0.8, 0], [-0.8, -0.8, 0], [0, 0, 0], [0.5, 0.1, 0]])
+QUAD_TRIANGLES = [0, 3, 4, 3, 2, 4, 2, 1, 5, 4, 2, 5, 1, 0, 5, 0, 4, 5]
+QUAD_COLORS = vertex_colors(len(QUAD))
+
+
+def sparse_block(count, indices_view, values_view, index_type=5125, indices_offset=0, values_offset=0):
+    return {"count": count, "indices": {"bufferView": indices_view, "componentType": index_type,
+                                        "byteOffset": indices_offset},
+            "values": {"bufferView": values_view, "byteOffset": values_offset}}
+
+
+INDEX_DTYPE = {5121: np.uint8, 5123: np.uint16, 5125: np.uint32}
+
+
+def write_sparse_quad(path, replaced, index_type=5125, base=True, block=None, index_values=None):
+    """QUAD as POSITION through a sparse accessor: the base values (QUAD with the `replaced` vertices
+    moved away, or no bufferView: zeros) and a sparse block putting QUAD's values back at `replaced`."""
+    base_values = QUAD.copy()
+    base_values[replaced] = [5, 5, 5]  # far outside the view: a missed substitution shows
+    index_values = replaced if index_values is None else index_values
+    chunks = [QUAD_COLORS.tobytes(), np.uint16(QUAD_TRIANGLES).tobytes(),
+              np.asarray(index_values, dtype=INDEX_DTYPE[index_type]).tobytes(), QUAD[replaced].tobytes()]
+    position = {"componentType": 5126, "count": len(QUAD), "type": "VEC3", "name": "sparse_pos",
+                "sparse": block or sparse_block(len(replaced), 2, 3, index_type)}
+    if base:
+        chunks.append(base_values.tobytes())
+        position["bufferView"] = 4
+    accessors = [position, vec_accessor(0, len(QUAD), "VEC4"), vec_accessor(1, len(QUAD_TRIANGLES), "SCALAR", 5123)]
+    prim = {"attributes": {"POSITION": 0, "COLOR_0": 1}, "indices": 2}
+    return write_mesh_gltf(path, chunks, accessors, [prim])
+
+
+def write_dense_quad(path, positions):
+    chunks = [positions.tobytes(), QUAD_COLORS.tobytes(), np.uint16(QUAD_TRIANGLES).tobytes()]
+    accessors = [vec_accessor(0, len(QUAD)), vec_accessor(1, len(QUAD), "VEC4"),
+                 vec_accessor(2, len(QUAD_TRIANGLES), "SCALAR", 5123)]
+    return write_mesh_gltf(path, chunks, accessors, [{"attributes": {"POSITION": 0, "COLOR_0": 1}, "indices": 2}])
+
+
+@pytest.mark.parametrize("index_type", [5121, 5123, 5125])
+@pytest.mark.parametrize("base", [True, False], ids=["base-view", "zeros"])
+def test_gltf_sparse_accessor_equals_the_dense_one(tmp_path, index_type, base):
+    replaced = [0, 2, 5] if base else [0, 1, 2, 3, 5]  # without a base view: every non-zero vertex
+    path = write_sparse_quad(tmp_path / "sparse.gltf", replaced, index_type, base)
+    # The oracle: the base values with the sparse values substituted, written densely.
+    dense = QUAD.copy() if base else np.zeros_like(QUAD)
+    if base:
+        dense[replaced] = [5, 5, 5]
+    dense[replaced] = QUAD[replaced]
+    got, scene = render_color(path)
+    want, oracle = render_color(write_dense_quad(tmp_path / "dense.gltf", dense))
+    np.testing.assert_array_equal(scene.draws[0].mesh.positions, oracle.draws[0].mesh.positions)
+    np.testing.assert_array_equal(scene.draws[0].mesh.positions, QUAD)
+    assert np.array_equal(got, want)
+    assert (got[..., 3] > 0).mean() > 0.5
+
+
+SPARSE_ERRORS = {
+    # name: (edit of write_sparse_quad's arguments, the problem the message names)
+    "index_out_of_range": (dict(index_values=[0, 2, 6]),
+                           r"sparse index 6 \(element 2\) is out of range \(the accessor's count is 6\)"),
+    "not_increasing": (dict(index_values=[0, 5, 2]), r"sparse indices are not strictly increasing.*5.*2"),
+    "repeated_index": (dict(index_values=[0, 2, 2]), r"sparse indices are not strictly increasing"),
+    "indices_outside_view": (dict(block=sparse_block(3, 2, 3, 5125, indices_offset=8)),
+                             r"sparse indices: 3 elements need 12 bytes from byte offset 8, buffer view 2 has 12"),
+    "values_outside_view": (dict(block=sparse_block(3, 2, 3, 5125, values_offset=4)),
+                            r"sparse values: 3 elements need 36 bytes from byte offset 4, buffer view 3 has 36"),
+    "values_view_missing": (dict(block=sparse_block(3, 2, 9)), r"sparse values: buffer view 9 does not exist"),
+    "count_too_large": (dict(block=sparse_block(7, 2, 3)), r"sparse count 7 is larger than the accessor's count 6"),
+    "count_zero": (dict(block=sparse_block(0, 2, 3)), r"sparse count 0 must be at least 1"),
+    "index_type": (dict(block=sparse_block(3, 2, 3, 5126)), r"sparse indices must be unsigned byte, short or int"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(SPARSE_ERRORS))
+def test_gltf_bad_sparse_block_is_an_error_naming_the_accessor(tmp_path, case):
+    edit, problem = SPARSE_ERRORS[case]
+    path = write_sparse_quad(tmp_path / "bad_sparse.gltf", [0, 2, 5], **edit)
+    with pytest.raises(OSError, match=r"bad_sparse\.gltf: .*POSITION \(accessor 0 'sparse_pos'\): " + problem):
+        mr.load_scene(path)
+
+
+def test_gltf_sparse_view_outside_its_buffer_is_an_error(tmp_path):
+    path = write_sparse_quad(tmp_path / "outside.gltf", [0, 2, 5])
+    doc = json.loads(path.read_text())
+    doc["bufferViews"][3]["byteOffset"] = doc["buffers"][0]["byteLength"] - 8
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=r"\(accessor 0 'sparse_pos'\): sparse values: buffer view 3 .* lies outside "
+                                      r"its buffer"):
+        mr.load_scene(path)

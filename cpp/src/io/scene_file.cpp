@@ -343,7 +343,8 @@ std::string percent_decode(const std::string& uri) {
 }
 
 /// Reads an accessor's elements as doubles (normalized integers mapped to [0, 1] / [−1, 1]),
-/// after checking that every byte it names lies inside its buffer.
+/// after checking that every byte it names lies inside its buffer. A sparse accessor is
+/// materialized first into an owned, tightly packed copy, which is then read like a dense one.
 class AccessorReader {
 public:
     AccessorReader(const tinygltf::Model& model, int index, const std::string& path, const std::string& what)
@@ -352,8 +353,7 @@ public:
             fail(path, what + ": accessor " + std::to_string(index) + " does not exist (the file has " +
                            std::to_string(model.accessors.size()) + ")");
         const tinygltf::Accessor& a = model.accessors[index];
-        what_ = what + " (accessor " + std::to_string(index) + ")";
-        if (a.sparse.isSparse) fail(path, what_ + ": sparse accessors are not supported");
+        what_ = what + " (accessor " + std::to_string(index) + (a.name.empty() ? "" : " '" + a.name + "'") + ")";
         count_ = a.count;
         components_ = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
         component_type_ = a.componentType;
@@ -363,30 +363,15 @@ public:
             fail(path, what_ + ": unsupported type " + std::to_string(a.type) + " / component type " +
                            std::to_string(a.componentType));
         if (count_ > kMaxElements) fail(path, what_ + ": absurd count " + std::to_string(count_));
-        if (count_ == 0) return;
-        if (a.bufferView < 0 || static_cast<std::size_t>(a.bufferView) >= model.bufferViews.size())
-            fail(path, what_ + ": buffer view " + std::to_string(a.bufferView) + " does not exist");
-        const tinygltf::BufferView& view = model.bufferViews[a.bufferView];
-        if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size())
-            fail(path, what_ + ": buffer " + std::to_string(view.buffer) + " does not exist");
-        const std::vector<unsigned char>& buffer = model.buffers[view.buffer].data;
-        const std::size_t element = static_cast<std::size_t>(components_) * static_cast<std::size_t>(size_);
-        stride_ = view.byteStride ? view.byteStride : element;
-        if (stride_ < element || stride_ > 252 + element)
-            fail(path, what_ + ": byte stride " + std::to_string(view.byteStride) + " is invalid");
-        // All sizes below are bounded: count ≤ 2^32 and stride ≤ 256, so no product overflows.
-        if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
-            fail(path, what_ + ": buffer view " + std::to_string(a.bufferView) + " (offset " +
-                           std::to_string(view.byteOffset) + ", length " + std::to_string(view.byteLength) +
-                           ") lies outside its buffer of " + std::to_string(buffer.size()) + " bytes");
-        if (a.byteOffset > view.byteLength)
-            fail(path, what_ + ": byte offset " + std::to_string(a.byteOffset) + " lies outside its buffer view");
-        const std::size_t needed = a.byteOffset + (count_ - 1) * stride_ + element;
-        if (needed > view.byteLength)
-            fail(path, what_ + ": " + std::to_string(count_) + " elements need " + std::to_string(needed) +
-                           " bytes, its buffer view has " + std::to_string(view.byteLength));
-        data_ = buffer.data() + view.byteOffset + a.byteOffset;
+        if (a.sparse.isSparse) {
+            materialize_sparse(model, a);
+        } else if (count_ > 0) {
+            read_dense(model, a);
+        }
     }
+    // data_ may point into owned_: a copy would point into the original's.
+    AccessorReader(const AccessorReader&) = delete;
+    AccessorReader& operator=(const AccessorReader&) = delete;
 
     std::size_t count() const { return count_; }
     int components() const { return components_; }
@@ -432,7 +417,105 @@ private:
     double scaled(double v, double max) const { return normalized_ ? v / max : v; }
     double signed_scaled(double v, double max) const { return normalized_ ? std::max(v / max, -1.0) : v; }
 
+    std::size_t element_size() const { return static_cast<std::size_t>(components_) * static_cast<std::size_t>(size_); }
+
+    /// Buffer view `index`, after checking that it and its buffer exist and that it lies inside the
+    /// buffer; `part` ("" or "sparse indices: " / "sparse values: ") says which part of the accessor
+    /// uses it.
+    const tinygltf::BufferView& checked_view(const tinygltf::Model& model, int index, const std::string& part) const {
+        if (index < 0 || static_cast<std::size_t>(index) >= model.bufferViews.size())
+            fail(path_, what_ + ": " + part + "buffer view " + std::to_string(index) + " does not exist");
+        const tinygltf::BufferView& view = model.bufferViews[index];
+        if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size())
+            fail(path_, what_ + ": " + part + "buffer " + std::to_string(view.buffer) + " does not exist");
+        const std::size_t buffer_size = model.buffers[view.buffer].data.size();
+        if (view.byteOffset > buffer_size || view.byteLength > buffer_size - view.byteOffset)
+            fail(path_, what_ + ": " + part + "buffer view " + std::to_string(index) + " (offset " +
+                            std::to_string(view.byteOffset) + ", length " + std::to_string(view.byteLength) +
+                            ") lies outside its buffer of " + std::to_string(buffer_size) + " bytes");
+        return view;
+    }
+
+    /// The bytes [offset, offset + needed) of buffer view `index`, which hold `elements` elements,
+    /// after checking that they lie inside the view (and the view inside its buffer).
+    const unsigned char* view_range(const tinygltf::Model& model, int index, std::size_t offset, std::size_t needed,
+                                    std::size_t elements, const std::string& part) const {
+        const tinygltf::BufferView& view = checked_view(model, index, part);
+        if (offset > view.byteLength || needed > view.byteLength - offset)
+            fail(path_, what_ + ": " + part + std::to_string(elements) + " elements need " + std::to_string(needed) +
+                            " bytes from byte offset " + std::to_string(offset) + ", buffer view " +
+                            std::to_string(index) + " has " + std::to_string(view.byteLength));
+        return model.buffers[view.buffer].data.data() + view.byteOffset + offset;
+    }
+
+    /// Points data_ at the accessor's count_ (> 0) elements in its buffer view, stride_ apart.
+    void read_dense(const tinygltf::Model& model, const tinygltf::Accessor& a) {
+        const tinygltf::BufferView& view = checked_view(model, a.bufferView, "");
+        const std::size_t element = element_size();
+        stride_ = view.byteStride ? view.byteStride : element;
+        if (stride_ < element || stride_ > 252 + element)
+            fail(path_, what_ + ": byte stride " + std::to_string(view.byteStride) + " is invalid");
+        // count ≤ 2^32 and stride ≤ 256: the product does not overflow.
+        data_ = view_range(model, a.bufferView, a.byteOffset, (count_ - 1) * stride_ + element, count_, "");
+    }
+
+    /// A sparse accessor (glTF 2.0 §3.6.2.3) copied into owned_, tightly packed: the base values
+    /// from its buffer view (zeros when it has none), then element sparse.indices[k] replaced by
+    /// sparse.values[k]. The indices must be unsigned byte/short/int, strictly increasing and below
+    /// count; both arrays are tightly packed in their views.
+    void materialize_sparse(const tinygltf::Model& model, const tinygltf::Accessor& a) {
+        const auto& sparse = a.sparse;
+        if (sparse.count < 1)
+            fail(path_, what_ + ": sparse count " + std::to_string(sparse.count) + " must be at least 1");
+        const std::size_t n = static_cast<std::size_t>(sparse.count);
+        if (n > count_)
+            fail(path_, what_ + ": sparse count " + std::to_string(n) + " is larger than the accessor's count " +
+                            std::to_string(count_));
+        const int index_type = sparse.indices.componentType;
+        if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            fail(path_, what_ + ": sparse indices must be unsigned byte, short or int, got component type " +
+                            std::to_string(index_type));
+        if (sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0)
+            fail(path_, what_ + ": sparse byte offsets must not be negative");
+
+        const std::size_t element = element_size();
+        owned_.assign(count_ * element, 0);
+        if (a.bufferView >= 0) {
+            read_dense(model, a);
+            for (std::size_t i = 0; i < count_; ++i) std::memcpy(&owned_[i * element], data_ + i * stride_, element);
+        }
+        const std::size_t index_size = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(index_type));
+        const unsigned char* indices = view_range(model, sparse.indices.bufferView, sparse.indices.byteOffset,
+                                                  n * index_size, n, "sparse indices: ");
+        const unsigned char* values = view_range(model, sparse.values.bufferView, sparse.values.byteOffset,
+                                                 n * element, n, "sparse values: ");
+        for (std::size_t k = 0; k < n; ++k) {
+            const std::uint64_t i = unsigned_at(indices + k * index_size, index_type);
+            if (i >= count_)
+                fail(path_, what_ + ": sparse index " + std::to_string(i) + " (element " + std::to_string(k) +
+                                ") is out of range (the accessor's count is " + std::to_string(count_) + ")");
+            if (k > 0 && i <= unsigned_at(indices + (k - 1) * index_size, index_type))
+                fail(path_, what_ + ": sparse indices are not strictly increasing: " +
+                                std::to_string(unsigned_at(indices + (k - 1) * index_size, index_type)) +
+                                " is followed by " + std::to_string(i) + " (element " + std::to_string(k) + ")");
+            std::memcpy(&owned_[i * element], values + k * element, element);
+        }
+        data_ = owned_.data();
+        stride_ = element;
+    }
+
+    /// The unsigned integer of component type `type` (unsigned byte, short or int) at p.
+    static std::uint64_t unsigned_at(const unsigned char* p, int type) {
+        switch (type) {
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return load<std::uint8_t>(p);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return load<std::uint16_t>(p);
+            default: return load<std::uint32_t>(p);
+        }
+    }
+
     std::string path_, what_;
+    std::vector<unsigned char> owned_;  // a sparse accessor's materialized elements
     const unsigned char* data_ = nullptr;
     std::size_t count_ = 0, stride_ = 0;
     int components_ = 0, component_type_ = 0, size_ = 0;

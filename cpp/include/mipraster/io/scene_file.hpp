@@ -75,7 +75,9 @@ struct LoadedScene {
 ///    mesh primitives of mode TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN (strips and fans become
 ///    triangles in the glTF spec's order, which keeps their winding for culling; fewer than 3
 ///    vertices give none and a warning; points and lines are skipped with a warning), indexed
-///    with any index component type or not, POSITION, COLOR_0 (vec3/vec4; float or normalized
+///    with any index component type or not, from dense or sparse accessors (sparse: the base
+///    values from its bufferView, or zeros without one, with sparse.values written over the
+///    elements sparse.indices names), POSITION, COLOR_0 (vec3/vec4; float or normalized
 ///    unsigned byte/short, all linear; vec4 is premultiplied), TEXCOORD_0 (vec2; float or normalized unsigned byte/short)
 ///    as uvs and NORMAL (vec3; float or normalized byte/short) as normals, drawn with the node's
 ///    world matrix (matrix or TRS, composed down the hierarchy); material baseColorFactor as the
@@ -103,8 +105,11 @@ struct LoadedScene {
 /// extension, and std::runtime_error (or std::invalid_argument from Mesh::validate) whose
 /// message names the file and the problem for a missing, truncated or corrupt file, an
 /// accessor outside its buffer or of the wrong type or count (e.g. TEXCOORD_0 that is not VEC2),
-/// an index out of range (vertex, texture coordinate, normal, material, texture, sampler,
-/// image source), an image bufferView outside its buffer, a node cycle or absurd counts.
+/// a sparse accessor whose indices are out of range, not strictly increasing or of a type other
+/// than unsigned byte/short/int, whose index or value views lie outside their buffers, or whose
+/// sparse count exceeds its count, an index out of range (vertex, texture coordinate, normal,
+/// material, texture, sampler, image source), an image bufferView outside its buffer, a node
+/// cycle or absurd counts.
 LoadedScene load_scene(const std::string& path);
 
 /// World-space axis-aligned bounds of the draws' vertices (model matrices applied). Returns
