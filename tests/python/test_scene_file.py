@@ -568,3 +568,66 @@ def test_gltf_sparse_view_outside_its_buffer_is_an_error(tmp_path):
     with pytest.raises(OSError, match=r"\(accessor 0 'sparse_pos'\): sparse values: buffer view 3 .* lies outside "
                                       r"its buffer"):
         mr.load_scene(path)
+
+
+# Texture coordinate sets and KHR_texture_transform on the base colour texture.
+
+QUAD_UVS = np.float32([[0, 0], [1, 0], [1, 1], [0, 1]])  # write_textured_gltf's uvs: (0, 0) top-left
+REPEAT_NEAREST = {"magFilter": 9728, "minFilter": 9728}
+
+
+def textured_variant(tmp_path, name, uv_sets, texture_info, materials_extra=None, extra=None):
+    """write_textured_gltf with TEXCOORD_k = uv_sets[k] (float VEC2, one bufferView each after the
+    quad's) and baseColorTexture = texture_info; nearest filtering with REPEAT wraps."""
+    path = write_textured_gltf(tmp_path / name, {"uri": "checker.png"}, REPEAT_NEAREST)
+    doc = json.loads(path.read_text())
+    buf = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
+    attributes = doc["meshes"][0]["primitives"][0]["attributes"]
+    del attributes["TEXCOORD_0"]
+    for k, uvs in enumerate(uv_sets):
+        data = np.float32(uvs).tobytes()
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": len(buf), "byteLength": len(data)})
+        doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 4,
+                                 "type": "VEC2"})
+        attributes[f"TEXCOORD_{k}"] = len(doc["accessors"]) - 1
+        buf += data
+    doc["buffers"][0] = {"byteLength": len(buf), "uri": data_uri(buf)}
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = texture_info
+    doc["materials"][0].update(materials_extra or {})
+    doc.update(extra or {})
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def test_gltf_base_color_texture_on_texcoord_1(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    flat = np.full((4, 2), 0.9, np.float32)  # TEXCOORD_0 would show one texel everywhere
+    path = textured_variant(tmp_path, "uv1.gltf", [flat, QUAD_UVS], {"index": 0, "texCoord": 1})
+    oracle = textured_variant(tmp_path, "uv0.gltf", [QUAD_UVS], {"index": 0})
+    got, scene = render_color(path, 32)
+    want, _ = render_color(oracle, 32)
+    np.testing.assert_array_equal(scene.draws[0].mesh.uvs, QUAD_UVS)
+    assert scene.draws[0].texture is not None
+    assert np.array_equal(got, want)
+    for q, expected in enumerate([TEXELS[0, 0], TEXELS[0, 1], TEXELS[1, 0], TEXELS[1, 1]]):
+        np.testing.assert_allclose(quadrant_colors(got)[q], expected, atol=1e-6)
+
+
+def test_gltf_missing_texcoord_n_draws_without_the_texture(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    path = textured_variant(tmp_path, "uv2.gltf", [QUAD_UVS, QUAD_UVS], {"index": 0, "texCoord": 2})
+    with pytest.warns(UserWarning, match=r"meshes\[0\]\.primitives\[0\] has no TEXCOORD_2 but its material "
+                                         r"'checker' \(materials\[0\]\) has a baseColorTexture; "
+                                         r"drawn without the texture"):
+        scene, _ = mr.load_scene(path)
+    assert scene.draws[0].texture is None
+
+
+def test_gltf_texcoord_n_with_the_wrong_count_is_an_error(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    path = textured_variant(tmp_path, "uv1_count.gltf", [QUAD_UVS, QUAD_UVS], {"index": 0, "texCoord": 1})
+    doc = json.loads(path.read_text())
+    doc["accessors"][-1]["count"] = 3
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=r"uv1_count\.gltf: .*TEXCOORD_1 \(accessor 4\): TEXCOORD_1 has 3 elements"):
+        mr.load_scene(path)

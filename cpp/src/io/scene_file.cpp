@@ -558,6 +558,11 @@ bool draws_triangles(int mode) {
            mode == TINYGLTF_MODE_TRIANGLE_FAN;
 }
 
+/// Which texture coordinate set (TEXCOORD_<set>) becomes a primitive's uvs.
+struct UvChoice {
+    int set = 0;
+};
+
 struct GltfLoader {
     const tinygltf::Model& model;
     const std::string& path;
@@ -607,17 +612,12 @@ struct GltfLoader {
         }
         if (!mat.doubleSided) draw.state.cull = CullMode::back;
 
-        // Base colour texture: TEXCOORD_0 only.
+        // Base colour texture, on the texture coordinate set base_color_uvs chose (the mesh's uvs).
         const tinygltf::TextureInfo& info = mat.pbrMetallicRoughness.baseColorTexture;
         if (info.index < 0) return;
         if (static_cast<std::size_t>(info.index) >= model.textures.size())
             fail(path, name + ": baseColorTexture index " + std::to_string(info.index) +
                            " does not exist (the file has " + std::to_string(model.textures.size()) + " textures)");
-        if (info.texCoord != 0) {
-            warn_once(name + ": baseColorTexture uses TEXCOORD_" + std::to_string(info.texCoord) +
-                      "; only TEXCOORD_0 is supported, so it is drawn without the texture");
-            return;
-        }
         if (info.extensions.count("KHR_texture_transform"))
             warn_once(name + ": KHR_texture_transform is not supported; the texture is drawn untransformed");
         const tinygltf::Texture& tex = model.textures[info.index];
@@ -627,7 +627,8 @@ struct GltfLoader {
             fail(path, tex_what + ": source image " + std::to_string(tex.source) + " does not exist (the file has " +
                            std::to_string(model.images.size()) + " images)");
         if (!draw.mesh->has_uvs()) {
-            warn_once(prim_what + " has no TEXCOORD_0 but its " + name +
+            warn_once(prim_what + " has no TEXCOORD_" + std::to_string(base_color_uvs(prim.material).set) +
+                      " but its " + name +
                       " has a baseColorTexture; drawn without the texture");
             return;
         }
@@ -816,6 +817,17 @@ struct GltfLoader {
         return triangles;
     }
 
+    /// The texture coordinate set the base colour texture of material `material` reads
+    /// (baseColorTexture.texCoord); set 0 for no material, an untextured one or one that does not
+    /// exist (apply_material reports that).
+    UvChoice base_color_uvs(int material) const {
+        UvChoice choice;
+        if (material < 0 || static_cast<std::size_t>(material) >= model.materials.size()) return choice;
+        const tinygltf::TextureInfo& info = model.materials[material].pbrMetallicRoughness.baseColorTexture;
+        if (info.index >= 0) choice.set = info.texCoord;
+        return choice;
+    }
+
     std::shared_ptr<Mesh> primitive_mesh(int mesh_index, int prim_index) {
         const auto key = std::make_pair(mesh_index, prim_index);
         if (auto it = mesh_cache.find(key); it != mesh_cache.end()) return it->second;
@@ -853,18 +865,23 @@ struct GltfLoader {
             }
         }
 
-        // Texture coordinates: float or normalized unsigned byte/short (glTF's uv convention is ours).
-        if (const auto uv_it = prim.attributes.find("TEXCOORD_0"); uv_it != prim.attributes.end()) {
-            const AccessorReader uv(model, uv_it->second, path, what + " TEXCOORD_0");
-            if (uv.components() != 2) fail(path, uv.what() + ": TEXCOORD_0 must be VEC2");
+        // Texture coordinates: the set the material's base colour texture reads (TEXCOORD_0 when it
+        // has none); float or normalized unsigned byte/short (glTF's uv convention is ours). The
+        // material is this primitive's own, as is this mesh (cached by (mesh, primitive)), so the
+        // choice reaches no other draw.
+        const UvChoice choice = base_color_uvs(prim.material);
+        const std::string uv_name = "TEXCOORD_" + std::to_string(choice.set);
+        if (const auto uv_it = prim.attributes.find(uv_name); uv_it != prim.attributes.end()) {
+            const AccessorReader uv(model, uv_it->second, path, what + " " + uv_name);
+            if (uv.components() != 2) fail(path, uv.what() + ": " + uv_name + " must be VEC2");
             const int ct = uv.component_type();
             if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
                 !((ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
                   uv.normalized()))
-                fail(path, uv.what() + ": TEXCOORD_0 must be float or normalized unsigned byte/short, got component type " +
-                               std::to_string(ct) + (uv.normalized() ? " (normalized)" : ""));
+                fail(path, uv.what() + ": " + uv_name + " must be float or normalized unsigned byte/short, got " +
+                               "component type " + std::to_string(ct) + (uv.normalized() ? " (normalized)" : ""));
             if (uv.count() != pos.count())
-                fail(path, uv.what() + ": TEXCOORD_0 has " + std::to_string(uv.count()) + " elements, POSITION " +
+                fail(path, uv.what() + ": " + uv_name + " has " + std::to_string(uv.count()) + " elements, POSITION " +
                                std::to_string(pos.count()));
             mesh->uvs.resize(uv.count());
             for (std::size_t i = 0; i < uv.count(); ++i) mesh->uvs[i] = glm::vec2(uv.get(i, 0), uv.get(i, 1));

@@ -78,11 +78,13 @@ struct LoadedScene {
 ///    with any index component type or not, from dense or sparse accessors (sparse: the base
 ///    values from its bufferView, or zeros without one, with sparse.values written over the
 ///    elements sparse.indices names), POSITION, COLOR_0 (vec3/vec4; float or normalized
-///    unsigned byte/short, all linear; vec4 is premultiplied), TEXCOORD_0 (vec2; float or normalized unsigned byte/short)
-///    as uvs and NORMAL (vec3; float or normalized byte/short) as normals, drawn with the node's
-///    world matrix (matrix or TRS, composed down the hierarchy); material baseColorFactor as the
-///    draw colour (linear RGBA; alphaMode BLEND blends "over" with the colour premultiplied by its
-///    alpha, other modes are opaque: alpha 1); doubleSided false culls back faces. The material's
+///    unsigned byte/short, all linear; vec4 is premultiplied), the texture coordinates the
+///    material's baseColorTexture reads (TEXCOORD_<texCoord>; TEXCOORD_0 for other materials;
+///    vec2, float or normalized unsigned byte/short) as uvs and NORMAL (vec3; float or
+///    normalized byte/short) as normals, drawn with the node's world matrix (matrix or TRS,
+///    composed down the hierarchy); material baseColorFactor as the draw colour (linear RGBA;
+///    alphaMode BLEND blends "over" with the colour premultiplied by its alpha, other modes are
+///    opaque: alpha 1); doubleSided false culls back faces. The material's
 ///    pbrMetallicRoughness.baseColorTexture becomes draw.texture: its image decoded from sRGB
 ///    into linear premultiplied RGBA (external files relative to the .gltf, percent-decoded;
 ///    data URIs and bufferViews from memory), its alpha ignored unless the material blends; the
@@ -93,10 +95,10 @@ struct LoadedScene {
 ///    9987 LINEAR_MIPMAP_LINEAR → (min_filter, mip_filter) = (nearest, nearest), (linear,
 ///    nearest), (nearest, linear), (linear, linear); undefined filters keep the library default
 ///    (trilinear), the footprint is isotropic, and values that are no glTF enum are warned about
-///    and replaced by the defaults. A baseColorTexture on another texCoord than 0, on a primitive
-///    without TEXCOORD_0, or whose texture has no source image is skipped with a warning (the
-///    draw is untextured); KHR_texture_transform is ignored with a warning. Cameras attached to
-///    nodes become NamedCameras in node order.
+///    and replaced by the defaults. A baseColorTexture on a primitive without the TEXCOORD_n it
+///    reads, or whose texture has no source image is skipped with a warning (the draw is
+///    untextured); KHR_texture_transform is ignored with a warning. Cameras attached to nodes
+///    become NamedCameras in node order.
 /// A texture file that is missing, unreadable or corrupt does not stop the load: the draw gets
 /// error_texture() (an 8×8 magenta/black checker) and a warning naming the material and the
 /// file. Images are shared through the texture cache (load_texture), so loading the same files
