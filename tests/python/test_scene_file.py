@@ -631,3 +631,107 @@ def test_gltf_texcoord_n_with_the_wrong_count_is_an_error(tmp_path):
     path.write_text(json.dumps(doc))
     with pytest.raises(OSError, match=r"uv1_count\.gltf: .*TEXCOORD_1 \(accessor 4\): TEXCOORD_1 has 3 elements"):
         mr.load_scene(path)
+
+
+def spec_uv_transform(uvs, offset=(0.0, 0.0), rotation=0.0, scale=(1.0, 1.0)):
+    """KHR_texture_transform, written out here as the oracle: uv' = T(offset) R(rotation) S(scale) uv
+    with R = [[cos, sin], [-sin, cos]] (the extension's example: offset (0, 1), rotation pi/2, scale
+    1/2 maps the unit square onto the image's lower-left quadrant, v down)."""
+    u, v = np.float64(uvs).T * np.float64(scale)[:, None]
+    c, s = math.cos(rotation), math.sin(rotation)
+    return np.float32(np.stack([c * u + s * v + offset[0], -s * u + c * v + offset[1]], axis=1))
+
+
+TRANSFORMS = {
+    "offset": dict(offset=[0.5, 0.25]),
+    "scale": dict(scale=[2.0, -3.0]),
+    "rotation": dict(rotation=0.7),
+    "all": dict(offset=[-0.3, 1.2], rotation=-2.1, scale=[1.5, 0.75]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(TRANSFORMS))
+def test_gltf_texture_transform_equals_uvs_transformed_by_the_spec(tmp_path, name):
+    write_texture(tmp_path / "checker.png")
+    transform = TRANSFORMS[name]
+    info = {"index": 0, "extensions": {"KHR_texture_transform": transform}}
+    path = textured_variant(tmp_path, "transform.gltf", [QUAD_UVS], info,
+                            extra={"extensionsUsed": ["KHR_texture_transform"]})
+    expected_uvs = spec_uv_transform(QUAD_UVS, **transform)
+    oracle = textured_variant(tmp_path, "transformed_uvs.gltf", [expected_uvs], {"index": 0})
+    got, scene = render_color(path, 32)
+    want, _ = render_color(oracle, 32)
+    np.testing.assert_allclose(scene.draws[0].mesh.uvs, expected_uvs, rtol=0, atol=1e-6)
+    assert np.array_equal(got, want)
+
+
+def test_gltf_texture_transform_follows_the_extensions_example(tmp_path):
+    # The extension's README: offset (0, 1), rotation pi/2, scale 1/2 "utilizes only the lower left
+    # quadrant of the source image": the 2x2 checker's blue texel fills the quad.
+    write_texture(tmp_path / "checker.png")
+    transform = {"offset": [0, 1], "rotation": math.pi / 2, "scale": [0.5, 0.5]}
+    info = {"index": 0, "extensions": {"KHR_texture_transform": transform}}
+    got, _ = render_color(textured_variant(tmp_path, "example.gltf", [QUAD_UVS], info), 32)
+    inner = got[2:-2, 2:-2].reshape(-1, 4)
+    np.testing.assert_allclose(inner, np.tile(TEXELS[1, 0], (len(inner), 1)), atol=1e-6)
+
+
+def test_gltf_texture_transform_texcoord_overrides_the_texture_infos(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    flat = np.full((4, 2), 0.9, np.float32)
+    transform = {"texCoord": 1, "scale": [0.5, 0.5]}
+    info = {"index": 0, "texCoord": 0, "extensions": {"KHR_texture_transform": transform}}
+    path = textured_variant(tmp_path, "override.gltf", [flat, QUAD_UVS], info)
+    got, scene = render_color(path, 32)
+    np.testing.assert_allclose(scene.draws[0].mesh.uvs, spec_uv_transform(QUAD_UVS, scale=(0.5, 0.5)))
+    inner = got[2:-2, 2:-2].reshape(-1, 4)
+    np.testing.assert_allclose(inner, np.tile(TEXELS[0, 0], (len(inner), 1)), atol=1e-6)  # all the red texel
+
+
+def test_gltf_texture_transform_does_not_leak_to_primitives_sharing_its_accessors(tmp_path):
+    # One mesh with two primitives on the same accessors, one material transformed and one not, and
+    # two nodes drawing that mesh: every draw gets its own material's uvs.
+    write_texture(tmp_path / "checker.png")
+    transform = {"offset": [0.25, 0.5]}
+    path = textured_variant(tmp_path, "shared.gltf", [QUAD_UVS],
+                            {"index": 0, "extensions": {"KHR_texture_transform": transform}})
+    doc = json.loads(path.read_text())
+    plain = dict(doc["materials"][0], name="plain",
+                 pbrMetallicRoughness={"baseColorTexture": {"index": 0}})
+    doc["materials"].append(plain)
+    prim = doc["meshes"][0]["primitives"][0]
+    doc["meshes"][0]["primitives"] = [prim, dict(prim, material=1), prim]
+    doc["nodes"].append({"mesh": 0, "translation": [0, 0, 1]})
+    doc["scenes"][0]["nodes"].append(len(doc["nodes"]) - 1)
+    path.write_text(json.dumps(doc))
+    scene, _ = mr.load_scene(path)
+    assert len(scene.draws) == 6
+    # The second node's draws share the first node's meshes; the primitives do not share one.
+    assert all(scene.draws[i].mesh is scene.draws[i + 3].mesh for i in range(3))
+    assert len({id(d.mesh) for d in scene.draws}) == 3
+    moved = spec_uv_transform(QUAD_UVS, offset=(0.25, 0.5))
+    for d, uvs in zip(scene.draws, [moved, QUAD_UVS, moved] * 2):
+        np.testing.assert_allclose(d.mesh.uvs, uvs, rtol=0, atol=1e-6)
+
+
+TRANSFORM_ERRORS = {
+    "offset_length": ({"offset": [0.5]}, r"KHR_texture_transform offset must be 2 finite numbers"),
+    "scale_length": ({"scale": [1, 2, 3]}, r"KHR_texture_transform scale must be 2 finite numbers"),
+    "scale_type": ({"scale": [1, "x"]}, r"KHR_texture_transform scale must be 2 finite numbers"),
+    "offset_object": ({"offset": {"u": 1, "v": 2}}, r"KHR_texture_transform offset must be 2 finite numbers"),
+    "rotation_type": ({"rotation": [1]}, r"KHR_texture_transform rotation must be a finite number"),
+    "rotation_string": ({"rotation": "0.5"}, r"KHR_texture_transform rotation must be a finite number"),
+    "texcoord": ({"texCoord": -1}, r"KHR_texture_transform texCoord must be an integer >= 0"),
+    "texcoord_real": ({"texCoord": 1.5}, r"KHR_texture_transform texCoord must be an integer >= 0"),
+}
+# (Non-finite values cannot reach the loader: JSON has none, and tinygltf's parser rejects 1e999.)
+
+
+@pytest.mark.parametrize("case", sorted(TRANSFORM_ERRORS))
+def test_gltf_bad_texture_transform_is_an_error_naming_the_material(tmp_path, case):
+    write_texture(tmp_path / "checker.png")
+    transform, problem = TRANSFORM_ERRORS[case]
+    info = {"index": 0, "extensions": {"KHR_texture_transform": transform}}
+    path = textured_variant(tmp_path, "bad_transform.gltf", [QUAD_UVS], info)
+    with pytest.raises(OSError, match=r"bad_transform\.gltf: material 'checker' \(materials\[0\]\): " + problem):
+        mr.load_scene(path)

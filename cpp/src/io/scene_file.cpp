@@ -558,9 +558,24 @@ bool draws_triangles(int mode) {
            mode == TINYGLTF_MODE_TRIANGLE_FAN;
 }
 
-/// Which texture coordinate set (TEXCOORD_<set>) becomes a primitive's uvs.
+/// Which texture coordinate set (TEXCOORD_<set>) becomes a primitive's uvs, and the affine map
+/// that KHR_texture_transform applies to it: uv' = T(offset)·R(rotation)·S(scale)·uv.
 struct UvChoice {
     int set = 0;
+    bool transformed = false;  // (the identity is skipped: it would turn an infinite v into NaN u)
+    glm::dvec2 offset{0.0}, scale{1.0};
+    double rotation = 0.0;
+
+    /// The transformed uv. R is [[cos, sin], [−sin, cos]] (row by row), the rotation Khronos'
+    /// sample models, Blender and three.js use: the extension's GLSL listing fills a column-major
+    /// mat3 with the same numbers, which reads as the transpose (KhronosGroup/glTF issue #1563);
+    /// its example (offset (0, 1), rotation π/2, scale ½ selects the lower-left quadrant) agrees
+    /// with this form only.
+    glm::vec2 apply(glm::dvec2 uv) const {
+        const double c = std::cos(rotation), s = std::sin(rotation);
+        const glm::dvec2 scaled = uv * scale;
+        return glm::vec2(c * scaled.x + s * scaled.y + offset.x, -s * scaled.x + c * scaled.y + offset.y);
+    }
 };
 
 struct GltfLoader {
@@ -612,14 +627,12 @@ struct GltfLoader {
         }
         if (!mat.doubleSided) draw.state.cull = CullMode::back;
 
-        // Base colour texture, on the texture coordinate set base_color_uvs chose (the mesh's uvs).
+        // Base colour texture, on the uvs base_color_uvs chose (and transformed) for the mesh.
         const tinygltf::TextureInfo& info = mat.pbrMetallicRoughness.baseColorTexture;
         if (info.index < 0) return;
         if (static_cast<std::size_t>(info.index) >= model.textures.size())
             fail(path, name + ": baseColorTexture index " + std::to_string(info.index) +
                            " does not exist (the file has " + std::to_string(model.textures.size()) + " textures)");
-        if (info.extensions.count("KHR_texture_transform"))
-            warn_once(name + ": KHR_texture_transform is not supported; the texture is drawn untransformed");
         const tinygltf::Texture& tex = model.textures[info.index];
         const std::string tex_what = "textures[" + std::to_string(info.index) + "]";
         Sampler sampler = sampler_of(tex.sampler, tex_what);  // checks the index even when unused below
@@ -818,13 +831,44 @@ struct GltfLoader {
     }
 
     /// The texture coordinate set the base colour texture of material `material` reads
-    /// (baseColorTexture.texCoord); set 0 for no material, an untextured one or one that does not
-    /// exist (apply_material reports that).
+    /// (baseColorTexture.texCoord, or its KHR_texture_transform's texCoord) and that extension's
+    /// transform; set 0 and the identity for no material, an untextured one or one that does not
+    /// exist (apply_material reports that). Malformed transform values are an error naming the
+    /// material.
     UvChoice base_color_uvs(int material) const {
         UvChoice choice;
         if (material < 0 || static_cast<std::size_t>(material) >= model.materials.size()) return choice;
-        const tinygltf::TextureInfo& info = model.materials[material].pbrMetallicRoughness.baseColorTexture;
-        if (info.index >= 0) choice.set = info.texCoord;
+        const tinygltf::Material& mat = model.materials[material];
+        const tinygltf::TextureInfo& info = mat.pbrMetallicRoughness.baseColorTexture;
+        if (info.index < 0) return choice;
+        choice.set = info.texCoord;
+        const auto ext = info.extensions.find("KHR_texture_transform");
+        if (ext == info.extensions.end()) return choice;
+
+        choice.transformed = true;
+        const std::string what = material_name(mat, material) + ": KHR_texture_transform ";
+        const tinygltf::Value& t = ext->second;  // (an object: tinygltf drops extensions that are not)
+        const auto finite_number = [](const tinygltf::Value& v) {
+            return v.IsNumber() && std::isfinite(v.GetNumberAsDouble());
+        };
+        const auto pair = [&](const char* key, glm::dvec2 value) {
+            if (!t.Has(key)) return value;
+            const tinygltf::Value& v = t.Get(key);
+            if (!v.IsArray() || v.ArrayLen() != 2 || !finite_number(v.Get(0)) || !finite_number(v.Get(1)))
+                fail(path, what + key + " must be 2 finite numbers");
+            return glm::dvec2(v.Get(0).GetNumberAsDouble(), v.Get(1).GetNumberAsDouble());
+        };
+        choice.offset = pair("offset", choice.offset);
+        choice.scale = pair("scale", choice.scale);
+        if (t.Has("rotation")) {
+            if (!finite_number(t.Get("rotation"))) fail(path, what + "rotation must be a finite number");
+            choice.rotation = t.Get("rotation").GetNumberAsDouble();
+        }
+        if (t.Has("texCoord")) {  // overrides the textureInfo's
+            const tinygltf::Value& v = t.Get("texCoord");
+            if (!v.IsInt() || v.GetNumberAsInt() < 0) fail(path, what + "texCoord must be an integer >= 0");
+            choice.set = v.GetNumberAsInt();
+        }
         return choice;
     }
 
@@ -866,9 +910,10 @@ struct GltfLoader {
         }
 
         // Texture coordinates: the set the material's base colour texture reads (TEXCOORD_0 when it
-        // has none); float or normalized unsigned byte/short (glTF's uv convention is ours). The
-        // material is this primitive's own, as is this mesh (cached by (mesh, primitive)), so the
-        // choice reaches no other draw.
+        // has none), with its KHR_texture_transform applied here (an affine map of the uvs commutes
+        // with perspective-correct interpolation, so this is exact); float or normalized unsigned
+        // byte/short (glTF's uv convention is ours). The material is this primitive's own, as is
+        // this mesh (cached by (mesh, primitive)), so neither choice reaches another draw.
         const UvChoice choice = base_color_uvs(prim.material);
         const std::string uv_name = "TEXCOORD_" + std::to_string(choice.set);
         if (const auto uv_it = prim.attributes.find(uv_name); uv_it != prim.attributes.end()) {
@@ -884,7 +929,10 @@ struct GltfLoader {
                 fail(path, uv.what() + ": " + uv_name + " has " + std::to_string(uv.count()) + " elements, POSITION " +
                                std::to_string(pos.count()));
             mesh->uvs.resize(uv.count());
-            for (std::size_t i = 0; i < uv.count(); ++i) mesh->uvs[i] = glm::vec2(uv.get(i, 0), uv.get(i, 1));
+            for (std::size_t i = 0; i < uv.count(); ++i) {
+                const glm::dvec2 value(uv.get(i, 0), uv.get(i, 1));
+                mesh->uvs[i] = choice.transformed ? choice.apply(value) : glm::vec2(value);
+            }
         }
 
         // Normals: float (or normalized signed byte/short, as KHR_mesh_quantization allows).

@@ -97,8 +97,10 @@ struct LoadedScene {
 ///    (trilinear), the footprint is isotropic, and values that are no glTF enum are warned about
 ///    and replaced by the defaults. A baseColorTexture on a primitive without the TEXCOORD_n it
 ///    reads, or whose texture has no source image is skipped with a warning (the draw is
-///    untextured); KHR_texture_transform is ignored with a warning. Cameras attached to nodes
-///    become NamedCameras in node order.
+///    untextured). The texture's KHR_texture_transform is applied to the mesh's uvs as they are
+///    read: uv' = T(offset)·R(rotation)·S(scale)·uv with R = [[cos, sin], [−sin, cos]] (row by
+///    row, as Khronos' sample models use it), and its texCoord overrides the texture's. Cameras
+///    attached to nodes become NamedCameras in node order.
 /// A texture file that is missing, unreadable or corrupt does not stop the load: the draw gets
 /// error_texture() (an 8×8 magenta/black checker) and a warning naming the material and the
 /// file. Images are shared through the texture cache (load_texture), so loading the same files
@@ -109,7 +111,8 @@ struct LoadedScene {
 /// accessor outside its buffer or of the wrong type or count (e.g. TEXCOORD_0 that is not VEC2),
 /// a sparse accessor whose indices are out of range, not strictly increasing or of a type other
 /// than unsigned byte/short/int, whose index or value views lie outside their buffers, or whose
-/// sparse count exceeds its count, an index out of range (vertex, texture coordinate, normal,
+/// sparse count exceeds its count, KHR_texture_transform values of the wrong type or length
+/// (naming the material), an index out of range (vertex, texture coordinate, normal,
 /// material, texture, sampler, image source), an image bufferView outside its buffer, a node
 /// cycle or absurd counts.
 LoadedScene load_scene(const std::string& path);
