@@ -735,3 +735,34 @@ def test_gltf_bad_texture_transform_is_an_error_naming_the_material(tmp_path, ca
     path = textured_variant(tmp_path, "bad_transform.gltf", [QUAD_UVS], info)
     with pytest.raises(OSError, match=r"bad_transform\.gltf: material 'checker' \(materials\[0\]\): " + problem):
         mr.load_scene(path)
+
+
+# extensionsRequired: an extension the loader cannot honour stops the load with a message naming it.
+
+@pytest.mark.parametrize("extension", ["KHR_draco_mesh_compression", "EXT_meshopt_compression",
+                                       "KHR_texture_basisu"])
+def test_gltf_required_extension_that_is_not_supported_is_named(tmp_path, extension):
+    path = write_gltf(tmp_path / "required.gltf")
+    doc = json.loads(path.read_text())
+    doc["extensionsUsed"] = doc["extensionsRequired"] = ["KHR_texture_transform", extension]
+    if extension == "KHR_draco_mesh_compression":  # as compressed files are: accessors without views
+        for a in doc["accessors"]:
+            del a["bufferView"]
+    elif extension == "EXT_meshopt_compression":  # a fallback buffer without data
+        doc["buffers"].append({"byteLength": 64})
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=rf"required\.gltf: the file requires the glTF extension '{extension}', "
+                                      r"which this loader does not support"):
+        mr.load_scene(path)
+
+
+@pytest.mark.parametrize("extension", ["KHR_texture_transform", "KHR_materials_unlit"])
+def test_gltf_required_extension_that_is_supported_loads(tmp_path, extension):
+    path = write_gltf(tmp_path / "required_ok.gltf")
+    doc = json.loads(path.read_text())
+    doc["extensionsUsed"] = doc["extensionsRequired"] = [extension]
+    path.write_text(json.dumps(doc))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scene, _ = mr.load_scene(path)
+    assert len(scene.draws[0].mesh.triangles) == 1

@@ -1039,6 +1039,24 @@ struct GltfLoader {
     }
 };
 
+/// The glTF extensions a file may list in extensionsRequired and still load as its author meant:
+/// those this loader reads (KHR_texture_transform on the base colour texture) and those that do
+/// not change what it draws (KHR_materials_unlit: its renders are unlit anyway).
+const std::set<std::string> kSupportedRequiredExtensions = {"KHR_materials_unlit", "KHR_texture_transform"};
+
+/// A file that requires another extension (compressed geometry, other image formats, …) cannot
+/// be drawn right: an error naming it. tinygltf only records the list, and without this the load
+/// failed later on what the extension changes, e.g. "accessor[1] invalid bufferView" for Draco.
+void check_required_extensions(const tinygltf::Model& model, const std::string& path) {
+    for (const std::string& extension : model.extensionsRequired) {
+        if (kSupportedRequiredExtensions.count(extension)) continue;
+        std::string supported;
+        for (const std::string& e : kSupportedRequiredExtensions) supported += (supported.empty() ? "" : ", ") + e;
+        fail(path, "the file requires the glTF extension '" + extension +
+                       "', which this loader does not support (it supports " + supported + ")");
+    }
+}
+
 // tinygltf's FileExists callback, for regular files only: a buffer whose uri named a directory
 // was opened and its "size" allocated (std::bad_alloc).
 bool regular_file_exists(const std::string& path, void*) {
@@ -1061,6 +1079,9 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
     } catch (const std::exception& e) {  // e.g. a JSON parser exception
         fail(path, std::string("cannot parse glTF: ") + e.what());
     }
+    // tinygltf reads extensionsRequired before the buffers and accessors, so the list is there even
+    // when the load failed on what an unsupported extension changes: that is the error to report.
+    check_required_extensions(model, path);
     if (!ok) fail(path, "cannot read glTF: " + trim(err.empty() ? warn : err));
 
     GltfLoader g(model, path, embedded);

@@ -111,7 +111,8 @@ struct LoadedScene {
 /// accessor outside its buffer or of the wrong type or count (e.g. TEXCOORD_0 that is not VEC2),
 /// a sparse accessor whose indices are out of range, not strictly increasing or of a type other
 /// than unsigned byte/short/int, whose index or value views lie outside their buffers, or whose
-/// sparse count exceeds its count, KHR_texture_transform values of the wrong type or length
+/// sparse count exceeds its count, an extensionsRequired entry other than KHR_materials_unlit and
+/// KHR_texture_transform (e.g. Draco or meshopt compression), KHR_texture_transform values of the wrong type or length
 /// (naming the material), an index out of range (vertex, texture coordinate, normal,
 /// material, texture, sampler, image source), an image bufferView outside its buffer, a node
 /// cycle or absurd counts.
