@@ -756,7 +756,7 @@ def test_gltf_required_extension_that_is_not_supported_is_named(tmp_path, extens
         mr.load_scene(path)
 
 
-@pytest.mark.parametrize("extension", ["KHR_texture_transform", "KHR_materials_unlit"])
+@pytest.mark.parametrize("extension", ["KHR_texture_transform", "KHR_materials_unlit", "KHR_mesh_quantization"])
 def test_gltf_required_extension_that_is_supported_loads(tmp_path, extension):
     path = write_gltf(tmp_path / "required_ok.gltf")
     doc = json.loads(path.read_text())
@@ -766,3 +766,34 @@ def test_gltf_required_extension_that_is_supported_loads(tmp_path, extension):
         warnings.simplefilter("error")
         scene, _ = mr.load_scene(path)
     assert len(scene.draws[0].mesh.triangles) == 1
+
+
+def test_gltf_mesh_quantization_texcoords(tmp_path):
+    # KHR_mesh_quantization allows TEXCOORD_n as (normalized or not) byte/short and unnormalized
+    # unsigned byte/short; the values are the integers (normalized: divided by 127 / 32767).
+    write_texture(tmp_path / "checker.png")
+    cases = [(5120, True, [0, 0, 127, 0, 127, 127, 0, 127], np.int8),
+             (5122, True, [0, 0, 32767, 0, 32767, 32767, 0, 32767], np.int16),
+             (5120, False, [0, 0, 1, 0, 1, 1, 0, 1], np.int8),
+             (5121, False, [0, 0, 1, 0, 1, 1, 0, 1], np.uint8),
+             (5122, False, [0, 0, 1, 0, 1, 1, 0, -1], np.int16),
+             (5123, False, [0, 0, 1, 0, 1, 1, 0, 1], np.uint16)]
+    for k, (component, normalized, values, dtype) in enumerate(cases):
+        path = textured_variant(tmp_path, f"quantized{k}.gltf", [QUAD_UVS], {"index": 0},
+                                extra={"extensionsUsed": ["KHR_mesh_quantization"],
+                                       "extensionsRequired": ["KHR_mesh_quantization"]})
+        doc = json.loads(path.read_text())
+        data = np.asarray(values, dtype=dtype).tobytes()
+        data += b"\0" * (-len(data) % 4)
+        buf = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": len(buf), "byteLength": len(data)})
+        buf += data
+        doc["buffers"][0] = {"byteLength": len(buf), "uri": data_uri(buf)}
+        doc["accessors"][-1] = {"bufferView": len(doc["bufferViews"]) - 1, "componentType": component,
+                                "normalized": normalized, "count": 4, "type": "VEC2"}
+        path.write_text(json.dumps(doc))
+        scene, _ = mr.load_scene(path)
+        scale = (127.0 if dtype == np.int8 else 32767.0) if normalized else 1.0
+        np.testing.assert_allclose(scene.draws[0].mesh.uvs, np.float32(values).reshape(4, 2) / scale,
+                                   err_msg=str((component, normalized)))
+        assert scene.draws[0].texture is not None

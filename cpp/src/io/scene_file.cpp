@@ -588,9 +588,15 @@ struct GltfLoader {
     std::set<std::string> warned;                                     // warnings given once
     std::size_t skipped_primitives = 0;
     std::vector<bool> on_path;  // nodes on the current root-to-node path (cycle detection)
+    bool quantized = false;     // the file uses KHR_mesh_quantization (integer texture coordinates)
 
     GltfLoader(const tinygltf::Model& m, const std::string& p, const EmbeddedImages& e)
-        : model(m), path(p), embedded(e), on_path(m.nodes.size(), false) {}
+        : model(m), path(p), embedded(e), on_path(m.nodes.size(), false) {
+        const auto lists = [&](const std::vector<std::string>& names) {
+            return std::find(names.begin(), names.end(), "KHR_mesh_quantization") != names.end();
+        };
+        quantized = lists(m.extensionsUsed) || lists(m.extensionsRequired);
+    }
 
     void warn_once(const std::string& message) {
         if (warned.insert(message).second) scene.warnings.push_back(path + ": " + message);
@@ -872,6 +878,18 @@ struct GltfLoader {
         return choice;
     }
 
+    /// Whether a TEXCOORD_n component type is allowed: float or normalized unsigned byte/short
+    /// (glTF 2.0), and in files that use KHR_mesh_quantization also byte and short (normalized or
+    /// not) and unnormalized unsigned byte/short, read as their integer values.
+    bool texcoord_type_allowed(int type, bool normalized) const {
+        if (type == TINYGLTF_COMPONENT_TYPE_FLOAT) return true;
+        const bool small_unsigned =
+            type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+        if (small_unsigned && normalized) return true;
+        return quantized &&
+               (small_unsigned || type == TINYGLTF_COMPONENT_TYPE_BYTE || type == TINYGLTF_COMPONENT_TYPE_SHORT);
+    }
+
     std::shared_ptr<Mesh> primitive_mesh(int mesh_index, int prim_index) {
         const auto key = std::make_pair(mesh_index, prim_index);
         if (auto it = mesh_cache.find(key); it != mesh_cache.end()) return it->second;
@@ -920,11 +938,12 @@ struct GltfLoader {
             const AccessorReader uv(model, uv_it->second, path, what + " " + uv_name);
             if (uv.components() != 2) fail(path, uv.what() + ": " + uv_name + " must be VEC2");
             const int ct = uv.component_type();
-            if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
-                !((ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
-                  uv.normalized()))
-                fail(path, uv.what() + ": " + uv_name + " must be float or normalized unsigned byte/short, got " +
-                               "component type " + std::to_string(ct) + (uv.normalized() ? " (normalized)" : ""));
+            if (!texcoord_type_allowed(ct, uv.normalized()))
+                fail(path, uv.what() + ": " + uv_name + " must be float or normalized unsigned byte/short" +
+                               (quantized ? " (or byte/short, normalized or not, and unsigned byte/short with "
+                                            "KHR_mesh_quantization)"
+                                          : "") +
+                               ", got component type " + std::to_string(ct) + (uv.normalized() ? " (normalized)" : ""));
             if (uv.count() != pos.count())
                 fail(path, uv.what() + ": " + uv_name + " has " + std::to_string(uv.count()) + " elements, POSITION " +
                                std::to_string(pos.count()));
@@ -1040,9 +1059,11 @@ struct GltfLoader {
 };
 
 /// The glTF extensions a file may list in extensionsRequired and still load as its author meant:
-/// those this loader reads (KHR_texture_transform on the base colour texture) and those that do
-/// not change what it draws (KHR_materials_unlit: its renders are unlit anyway).
-const std::set<std::string> kSupportedRequiredExtensions = {"KHR_materials_unlit", "KHR_texture_transform"};
+/// those this loader reads (KHR_texture_transform on the base colour texture; KHR_mesh_quantization's
+/// integer POSITION, NORMAL and TEXCOORD_n) and those that do not change what it draws
+/// (KHR_materials_unlit: its renders are unlit anyway).
+const std::set<std::string> kSupportedRequiredExtensions = {"KHR_materials_unlit", "KHR_mesh_quantization",
+                                                            "KHR_texture_transform"};
 
 /// A file that requires another extension (compressed geometry, other image formats, …) cannot
 /// be drawn right: an error naming it. tinygltf only records the list, and without this the load

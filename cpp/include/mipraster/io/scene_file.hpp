@@ -80,7 +80,8 @@ struct LoadedScene {
 ///    elements sparse.indices names), POSITION, COLOR_0 (vec3/vec4; float or normalized
 ///    unsigned byte/short, all linear; vec4 is premultiplied), the texture coordinates the
 ///    material's baseColorTexture reads (TEXCOORD_<texCoord>; TEXCOORD_0 for other materials;
-///    vec2, float or normalized unsigned byte/short) as uvs and NORMAL (vec3; float or
+///    vec2, float or normalized unsigned byte/short; in files that use KHR_mesh_quantization
+///    also byte/short, normalized or not, and unnormalized unsigned byte/short) as uvs and NORMAL (vec3; float or
 ///    normalized byte/short) as normals, drawn with the node's world matrix (matrix or TRS,
 ///    composed down the hierarchy); material baseColorFactor as the draw colour (linear RGBA;
 ///    alphaMode BLEND blends "over" with the colour premultiplied by its alpha, other modes are
@@ -111,8 +112,9 @@ struct LoadedScene {
 /// accessor outside its buffer or of the wrong type or count (e.g. TEXCOORD_0 that is not VEC2),
 /// a sparse accessor whose indices are out of range, not strictly increasing or of a type other
 /// than unsigned byte/short/int, whose index or value views lie outside their buffers, or whose
-/// sparse count exceeds its count, an extensionsRequired entry other than KHR_materials_unlit and
-/// KHR_texture_transform (e.g. Draco or meshopt compression), KHR_texture_transform values of the wrong type or length
+/// sparse count exceeds its count, an extensionsRequired entry other than KHR_materials_unlit,
+/// KHR_mesh_quantization and KHR_texture_transform (e.g. Draco or meshopt compression),
+/// KHR_texture_transform values of the wrong type or length
 /// (naming the material), an index out of range (vertex, texture coordinate, normal,
 /// material, texture, sampler, image source), an image bufferView outside its buffer, a node
 /// cycle or absurd counts.
