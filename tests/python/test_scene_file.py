@@ -570,6 +570,18 @@ def test_gltf_sparse_view_outside_its_buffer_is_an_error(tmp_path):
         mr.load_scene(path)
 
 
+def test_gltf_sparse_accessor_beyond_the_memory_limit_is_refused(tmp_path):
+    # Without a base view, a few bytes of JSON can ask for count x element bytes of zeros: 4294967295
+    # VEC3 floats are 48 GiB, above the default limit, refused before anything is allocated.
+    path = write_sparse_quad(tmp_path / "huge.gltf", [0, 2, 5], base=False)
+    doc = json.loads(path.read_text())
+    doc["accessors"][0]["count"] = 2**32 - 1
+    path.write_text(json.dumps(doc))
+    with pytest.raises(mr.MemoryLimitError, match=r"huge\.gltf: .*\(accessor 0 'sparse_pos'\) \(a sparse accessor\) "
+                                                  r"needs 48\.0 GiB"):
+        mr.load_scene(path)
+
+
 # Texture coordinate sets and KHR_texture_transform on the base colour texture.
 
 QUAD_UVS = np.float32([[0, 0], [1, 0], [1, 1], [0, 1]])  # write_textured_gltf's uvs: (0, 0) top-left

@@ -3,6 +3,7 @@
 #include "mipraster/io/scene_file.hpp"
 
 #include "file_extension.hpp"
+#include "mipraster/core/memory_limit.hpp"
 #include "mipraster/io/texture_file.hpp"
 
 #include <algorithm>
@@ -480,6 +481,8 @@ private:
             fail(path_, what_ + ": sparse byte offsets must not be negative");
 
         const std::size_t element = element_size();
+        // Without a base view, a few bytes of JSON can ask for count × element bytes of zeros.
+        check_memory(static_cast<std::uint64_t>(count_) * element, path_ + ": " + what_ + " (a sparse accessor)");
         owned_.assign(count_ * element, 0);
         if (a.bufferView >= 0) {
             read_dense(model, a);
