@@ -2,12 +2,13 @@
 
 The files are read by ``mipraster._image`` (the module that holds the file formats, imported on
 first use); this module turns what it returns into :class:`Mesh`, :class:`Scene` and
-:class:`Camera` objects. What loads: triangle geometry, vertex colours (linear), material colours
-(OBJ ``Kd``, glTF ``baseColorFactor``, both linear), texture coordinates (OBJ ``vt`` with v
-flipped to the glTF convention) and normals, base colour textures (OBJ ``map_Kd``, glTF
-``baseColorTexture``; sRGB) with their samplers, glTF node transforms, alpha blending
-(``alphaMode: BLEND``), back-face culling of single-sided glTF materials, and glTF cameras. A
-texture that cannot be read is replaced by a magenta/black checker, with a warning.
+:class:`Camera` objects. What loads: triangle geometry (glTF triangles, strips and fans; dense
+and sparse accessors), vertex colours (linear), material colours (OBJ ``Kd``, glTF
+``baseColorFactor``, both linear), texture coordinates (OBJ ``vt`` with v flipped to the glTF
+convention; glTF ``KHR_texture_transform`` applied) and normals, base colour textures (OBJ
+``map_Kd``, glTF ``baseColorTexture``; sRGB) with their samplers, glTF node transforms, alpha
+blending (``alphaMode: BLEND``), back-face culling of single-sided glTF materials, and glTF
+cameras. A texture that cannot be read is replaced by a magenta/black checker, with a warning.
 """
 from __future__ import annotations
 
@@ -64,10 +65,11 @@ def load_scene(path: PathLike) -> Tuple[Scene, List[Camera]]:
         and the file's cameras in node order as :class:`Camera` objects (OBJ has none). A
         perspective camera uses the file's aspect ratio if it gives one, else the render's;
         reverse-Z depth, infinite far plane when the file gives no ``zfar``. The scene's
-        ``clear_color`` is left None (transparent black). Meshes carry the file's uvs (glTF
-        ``TEXCOORD_0``; OBJ ``vt`` with v flipped, OBJ vertices split where a position has several
-        texture coordinates or normals) and normals. A draw whose material has a base colour
-        texture (glTF ``baseColorTexture`` on ``TEXCOORD_0``, OBJ ``map_Kd``, both decoded from
+        ``clear_color`` is left None (transparent black). Meshes carry the file's uvs (glTF: the
+        ``TEXCOORD_n`` the base colour texture reads, ``TEXCOORD_0`` without one, with its
+        ``KHR_texture_transform`` applied; OBJ ``vt`` with v flipped, OBJ vertices split where a
+        position has several texture coordinates or normals) and normals. A draw whose material
+        has a base colour texture (glTF ``baseColorTexture``, OBJ ``map_Kd``, both decoded from
         sRGB; the texture's alpha is ignored unless the material blends) gets it as
         ``draw.texture``, with ``draw.sampler`` from the glTF sampler (wrap and filter enums;
         undefined filters are trilinear) or the default sampler (OBJ; ``-clamp on`` clamps). A

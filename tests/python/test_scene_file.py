@@ -4,6 +4,7 @@ import base64
 import json
 import math
 import os
+import re
 import struct
 import subprocess
 import warnings
@@ -322,3 +323,489 @@ def test_scene_file_renders_are_deterministic(tmp_path):
         assert r.returncode == 0, r.stderr
         outs.append(out.read_bytes())
     assert outs[0] == outs[1]
+
+
+# --- glTF as found in the wild: strips and fans, sparse accessors, texCoord sets, texture transforms,
+# required extensions. Each file is compared with an independent oracle: the same surface written in
+# the plain form the loader already read (TRIANGLES, dense accessors, TEXCOORD_0, uvs transformed here).
+
+def data_uri(data):
+    return "data:application/octet-stream;base64," + base64.b64encode(data).decode()
+
+
+def write_mesh_gltf(path, chunks, accessors, primitives, materials=None, extra=None, camera_z=5.0, meshes=None,
+                    nodes=None):
+    """A glTF file whose buffer is `chunks` (one bufferView each, 4-byte aligned), with `accessors`,
+    one mesh of `primitives` (or `meshes`) on node 0 (or `nodes`) and an orthographic camera on the z axis
+    at `camera_z` looking at the origin, seeing [-1, 1]^2; `extra` is merged into the document."""
+    buf, views = b"", []
+    for chunk in chunks:
+        views.append({"buffer": 0, "byteOffset": len(buf), "byteLength": len(chunk)})
+        buf += chunk + b"\0" * (-len(chunk) % 4)
+    # A camera at -z looks back at the origin: rotated half a turn about y.
+    cam_node = {"camera": 0, "translation": [0, 0, camera_z]}
+    if camera_z < 0:
+        cam_node["rotation"] = [0, 1, 0, 0]
+    nodes = nodes if nodes is not None else [{"mesh": 0}]
+    doc = {
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": list(range(len(nodes) + 1))}],
+        "nodes": nodes + [cam_node],
+        "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}],
+        "meshes": meshes if meshes is not None else [{"primitives": primitives}],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": len(buf), "uri": data_uri(buf)}],
+    }
+    if materials is not None:
+        doc["materials"] = materials
+    doc.update(extra or {})
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def vec_accessor(view, count, kind="VEC3", component=5126, **more):
+    return {"bufferView": view, "componentType": component, "count": count, "type": kind, **more}
+
+
+def load_warning_texts(path):
+    """mr.load_scene(path) and the texts of the warnings it gave."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        scene, cameras = mr.load_scene(path)
+    return scene, [str(w.message) for w in caught]
+
+
+def render_color(path, size=48):
+    """The colour render (one sample per pixel) of a file through its camera."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a file the loader reads fully gives no warning
+        scene, cameras = mr.load_scene(path)
+    return mr.render(scene, cameras[0], size, size).color, scene
+
+
+# A zigzag ribbon in z = 0: with the spec's strip winding every triangle is counter-clockwise seen
+# from +z (front-facing for the camera on +z).
+STRIP = np.float32([[-0.9, 0.5, 0], [-0.9, -0.5, 0], [-0.3, 0.6, 0], [-0.3, -0.4, 0],
+                    [0.3, 0.5, 0], [0.3, -0.6, 0], [0.9, 0.4, 0]])
+# A fan: the centre, then rim points counter-clockwise seen from +z.
+FAN = np.float32([[0, 0, 0], [0.8, 0, 0], [0.5, 0.6, 0], [0, 0.9, 0], [-0.6, 0.5, 0], [-0.8, -0.2, 0],
+                  [0, -0.8, 0]])
+
+
+def vertex_colors(n):
+    rng = np.random.default_rng(n)
+    return np.float32(rng.uniform(0.1, 1.0, (n, 4)))
+
+
+def spec_triangles(mode, sequence):
+    """glTF 2.0 §3.7.2.1, written out here as the oracle: strip triangle i is
+    (v[i], v[i + (1 + i % 2)], v[i + (2 - i % 2)]), fan triangle i is (v[i + 1], v[i + 2], v[0])."""
+    n = len(sequence)
+    if mode == 5:
+        return [(sequence[i], sequence[i + 1 + i % 2], sequence[i + 2 - i % 2]) for i in range(n - 2)]
+    return [(sequence[i + 1], sequence[i + 2], sequence[0]) for i in range(n - 2)]
+
+
+def write_assembled(path, mode, positions, indices=None, double_sided=False, camera_z=5.0):
+    """`positions` (and COLOR_0) drawn as one primitive of `mode`, indexed when `indices` is given."""
+    n = len(positions)
+    chunks = [positions.tobytes(), vertex_colors(n).tobytes()]
+    accessors = [vec_accessor(0, n), vec_accessor(1, n, "VEC4")]
+    prim = {"attributes": {"POSITION": 0, "COLOR_0": 1}, "mode": mode, "material": 0}
+    if indices is not None:
+        chunks.append(np.uint16(indices).tobytes())
+        accessors.append(vec_accessor(2, len(indices), "SCALAR", 5123))
+        prim["indices"] = 2
+    materials = [{"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1]}, "doubleSided": double_sided}]
+    return write_mesh_gltf(path, chunks, accessors, [prim], materials, camera_z=camera_z)
+
+
+@pytest.mark.parametrize("mode, positions", [(5, STRIP), (6, FAN)], ids=["strip", "fan"])
+@pytest.mark.parametrize("indexed", [False, True])
+def test_gltf_strips_and_fans_render_as_their_spec_triangles(tmp_path, mode, positions, indexed):
+    n = len(positions)
+    # Indexed: the vertices stored in a shuffled order, the index list putting them back.
+    order = np.random.default_rng(3).permutation(n) if indexed else np.arange(n)
+    stored = positions[order] if indexed else positions
+    sequence = [int(np.flatnonzero(order == v)[0]) for v in range(n)] if indexed else list(range(n))
+    path = write_assembled(tmp_path / "assembled.gltf", mode, stored, sequence if indexed else None)
+    # The oracle: the same vertex buffer (and colours) drawn as TRIANGLES with the spec's index list.
+    triangles = [v for tri in spec_triangles(mode, sequence) for v in tri]
+    oracle = write_assembled(tmp_path / "triangles.gltf", 4, stored, triangles)
+    got, scene = render_color(path)
+    want, oracle_scene = render_color(oracle)
+    np.testing.assert_array_equal(scene.draws[0].mesh.triangles, oracle_scene.draws[0].mesh.triangles)
+    assert np.array_equal(got, want)
+    assert (got[..., 3] > 0).sum() > 0.3 * got.shape[0] * got.shape[1]  # a real picture
+
+
+@pytest.mark.parametrize("mode, positions", [(5, STRIP), (6, FAN)], ids=["strip", "fan"])
+def test_gltf_single_sided_strip_and_fan_draw_every_triangle_from_the_front_only(tmp_path, mode, positions):
+    # Culling is the independent check of the winding: seen from the front every triangle draws
+    # (a strip whose odd triangles kept the stored order would lose them to back-face culling), and
+    # seen from behind none does.
+    size = 64
+    front, scene = render_color(write_assembled(tmp_path / "front.gltf", mode, positions), size)
+    back, _ = render_color(write_assembled(tmp_path / "back.gltf", mode, positions, camera_z=-5.0), size)
+    assert len(scene.draws[0].mesh.triangles) == len(positions) - 2
+    for tri in spec_triangles(mode, list(range(len(positions)))):
+        x, y = positions[list(tri), :2].mean(axis=0)
+        # The orthographic camera sees [-1, 1]^2: column (x + 1) / 2 * size, row (1 - y) / 2 * size.
+        col, row = int((x + 1) / 2 * size), int((1 - y) / 2 * size)
+        assert front[row, col, 3] == 1.0, (tri, row, col)
+    assert (back[..., 3] == 0).all()
+
+
+@pytest.mark.parametrize("mode", [5, 6])
+@pytest.mark.parametrize("indexed", [False, True])
+def test_gltf_strip_or_fan_of_fewer_than_three_vertices_warns(tmp_path, mode, indexed):
+    positions = STRIP[:2]
+    path = write_assembled(tmp_path / "short.gltf", mode, positions, [0, 1] if indexed else None)
+    scene, texts = load_warning_texts(path)
+    assert any(re.search(r"meshes\[0\]\.primitives\[0\]: a triangle (strip|fan) of 2 vertices has no triangle", t)
+               for t in texts), texts
+    assert len(scene.draws[0].mesh.triangles) == 0
+
+
+@pytest.mark.parametrize("mode", [0, 1, 2, 3])
+def test_gltf_points_and_lines_stay_skipped_with_a_warning(tmp_path, mode):
+    path = write_assembled(tmp_path / "lines.gltf", mode, STRIP)
+    scene, texts = load_warning_texts(path)
+    assert any(re.search(r"skipped 1 primitive\(s\) of mode POINTS or LINES", t) for t in texts), texts
+    assert scene.draws == [] or all(len(d.mesh.triangles) == 0 for d in scene.draws)
+
+
+# Sparse accessors (glTF 2.0 §3.6.2.3).
+
+QUAD = np.float32([[-0.8, 0.8, 0], [0.8, 0.8, 0], [0.8, -0.8, 0], [-0.8, -0.8, 0], [0, 0, 0], [0.5, 0.1, 0]])
+QUAD_TRIANGLES = [0, 3, 4, 3, 2, 4, 2, 1, 5, 4, 2, 5, 1, 0, 5, 0, 4, 5]
+QUAD_COLORS = vertex_colors(len(QUAD))
+
+
+def sparse_block(count, indices_view, values_view, index_type=5125, indices_offset=0, values_offset=0):
+    return {"count": count, "indices": {"bufferView": indices_view, "componentType": index_type,
+                                        "byteOffset": indices_offset},
+            "values": {"bufferView": values_view, "byteOffset": values_offset}}
+
+
+INDEX_DTYPE = {5121: np.uint8, 5123: np.uint16, 5125: np.uint32}
+
+
+def write_sparse_quad(path, replaced, index_type=5125, base=True, block=None, index_values=None):
+    """QUAD as POSITION through a sparse accessor: the base values (QUAD with the `replaced` vertices
+    moved away, or no bufferView: zeros) and a sparse block putting QUAD's values back at `replaced`."""
+    base_values = QUAD.copy()
+    base_values[replaced] = [5, 5, 5]  # far outside the view: a missed substitution shows
+    index_values = replaced if index_values is None else index_values
+    chunks = [QUAD_COLORS.tobytes(), np.uint16(QUAD_TRIANGLES).tobytes(),
+              np.asarray(index_values, dtype=INDEX_DTYPE[index_type]).tobytes(), QUAD[replaced].tobytes()]
+    position = {"componentType": 5126, "count": len(QUAD), "type": "VEC3", "name": "sparse_pos",
+                "sparse": block or sparse_block(len(replaced), 2, 3, index_type)}
+    if base:
+        chunks.append(base_values.tobytes())
+        position["bufferView"] = 4
+    accessors = [position, vec_accessor(0, len(QUAD), "VEC4"), vec_accessor(1, len(QUAD_TRIANGLES), "SCALAR", 5123)]
+    prim = {"attributes": {"POSITION": 0, "COLOR_0": 1}, "indices": 2}
+    return write_mesh_gltf(path, chunks, accessors, [prim])
+
+
+def write_dense_quad(path, positions):
+    chunks = [positions.tobytes(), QUAD_COLORS.tobytes(), np.uint16(QUAD_TRIANGLES).tobytes()]
+    accessors = [vec_accessor(0, len(QUAD)), vec_accessor(1, len(QUAD), "VEC4"),
+                 vec_accessor(2, len(QUAD_TRIANGLES), "SCALAR", 5123)]
+    return write_mesh_gltf(path, chunks, accessors, [{"attributes": {"POSITION": 0, "COLOR_0": 1}, "indices": 2}])
+
+
+@pytest.mark.parametrize("index_type", [5121, 5123, 5125])
+@pytest.mark.parametrize("base", [True, False], ids=["base-view", "zeros"])
+def test_gltf_sparse_accessor_equals_the_dense_one(tmp_path, index_type, base):
+    replaced = [0, 2, 5] if base else [0, 1, 2, 3, 5]  # without a base view: every non-zero vertex
+    path = write_sparse_quad(tmp_path / "sparse.gltf", replaced, index_type, base)
+    # The oracle: the base values with the sparse values substituted, written densely.
+    dense = QUAD.copy() if base else np.zeros_like(QUAD)
+    if base:
+        dense[replaced] = [5, 5, 5]
+    dense[replaced] = QUAD[replaced]
+    got, scene = render_color(path)
+    want, oracle = render_color(write_dense_quad(tmp_path / "dense.gltf", dense))
+    np.testing.assert_array_equal(scene.draws[0].mesh.positions, oracle.draws[0].mesh.positions)
+    np.testing.assert_array_equal(scene.draws[0].mesh.positions, QUAD)
+    assert np.array_equal(got, want)
+    assert (got[..., 3] > 0).mean() > 0.5
+
+
+SPARSE_ERRORS = {
+    # name: (edit of write_sparse_quad's arguments, the problem the message names)
+    "index_out_of_range": (dict(index_values=[0, 2, 6]),
+                           r"sparse index 6 \(element 2\) is out of range \(the accessor's count is 6\)"),
+    "not_increasing": (dict(index_values=[0, 5, 2]), r"sparse indices are not strictly increasing.*5.*2"),
+    "repeated_index": (dict(index_values=[0, 2, 2]), r"sparse indices are not strictly increasing"),
+    "indices_outside_view": (dict(block=sparse_block(3, 2, 3, 5125, indices_offset=8)),
+                             r"sparse indices: 3 elements need 12 bytes from byte offset 8, buffer view 2 has 12"),
+    "values_outside_view": (dict(block=sparse_block(3, 2, 3, 5125, values_offset=4)),
+                            r"sparse values: 3 elements need 36 bytes from byte offset 4, buffer view 3 has 36"),
+    "values_view_missing": (dict(block=sparse_block(3, 2, 9)), r"sparse values: buffer view 9 does not exist"),
+    "count_too_large": (dict(block=sparse_block(7, 2, 3)), r"sparse count 7 is larger than the accessor's count 6"),
+    "count_zero": (dict(block=sparse_block(0, 2, 3)), r"sparse count 0 must be at least 1"),
+    "index_type": (dict(block=sparse_block(3, 2, 3, 5126)), r"sparse indices must be unsigned byte, short or int"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(SPARSE_ERRORS))
+def test_gltf_bad_sparse_block_is_an_error_naming_the_accessor(tmp_path, case):
+    edit, problem = SPARSE_ERRORS[case]
+    path = write_sparse_quad(tmp_path / "bad_sparse.gltf", [0, 2, 5], **edit)
+    with pytest.raises(OSError, match=r"bad_sparse\.gltf: .*POSITION \(accessor 0 'sparse_pos'\): " + problem):
+        mr.load_scene(path)
+
+
+def test_gltf_sparse_view_outside_its_buffer_is_an_error(tmp_path):
+    path = write_sparse_quad(tmp_path / "outside.gltf", [0, 2, 5])
+    doc = json.loads(path.read_text())
+    doc["bufferViews"][3]["byteOffset"] = doc["buffers"][0]["byteLength"] - 8
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=r"\(accessor 0 'sparse_pos'\): sparse values: buffer view 3 .* lies outside "
+                                      r"its buffer"):
+        mr.load_scene(path)
+
+
+def test_gltf_sparse_accessor_beyond_the_memory_limit_is_refused(tmp_path):
+    # Without a base view, a few bytes of JSON can ask for count x element bytes of zeros: 4294967295
+    # VEC3 floats are 48 GiB, above the default limit, refused before anything is allocated.
+    path = write_sparse_quad(tmp_path / "huge.gltf", [0, 2, 5], base=False)
+    doc = json.loads(path.read_text())
+    doc["accessors"][0]["count"] = 2**32 - 1
+    path.write_text(json.dumps(doc))
+    with pytest.raises(mr.MemoryLimitError, match=r"huge\.gltf: .*\(accessor 0 'sparse_pos'\) \(a sparse accessor\) "
+                                                  r"needs 48\.0 GiB"):
+        mr.load_scene(path)
+
+
+# Texture coordinate sets and KHR_texture_transform on the base colour texture.
+
+QUAD_UVS = np.float32([[0, 0], [1, 0], [1, 1], [0, 1]])  # write_textured_gltf's uvs: (0, 0) top-left
+REPEAT_NEAREST = {"magFilter": 9728, "minFilter": 9728}
+
+
+def textured_variant(tmp_path, name, uv_sets, texture_info, materials_extra=None, extra=None):
+    """write_textured_gltf with TEXCOORD_k = uv_sets[k] (float VEC2, one bufferView each after the
+    quad's) and baseColorTexture = texture_info; nearest filtering with REPEAT wraps."""
+    path = write_textured_gltf(tmp_path / name, {"uri": "checker.png"}, REPEAT_NEAREST)
+    doc = json.loads(path.read_text())
+    buf = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
+    attributes = doc["meshes"][0]["primitives"][0]["attributes"]
+    del attributes["TEXCOORD_0"]
+    for k, uvs in enumerate(uv_sets):
+        data = np.float32(uvs).tobytes()
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": len(buf), "byteLength": len(data)})
+        doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": 4,
+                                 "type": "VEC2"})
+        attributes[f"TEXCOORD_{k}"] = len(doc["accessors"]) - 1
+        buf += data
+    doc["buffers"][0] = {"byteLength": len(buf), "uri": data_uri(buf)}
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = texture_info
+    doc["materials"][0].update(materials_extra or {})
+    doc.update(extra or {})
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def test_gltf_base_color_texture_on_texcoord_1(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    flat = np.full((4, 2), 0.9, np.float32)  # TEXCOORD_0 would show one texel everywhere
+    path = textured_variant(tmp_path, "uv1.gltf", [flat, QUAD_UVS], {"index": 0, "texCoord": 1})
+    oracle = textured_variant(tmp_path, "uv0.gltf", [QUAD_UVS], {"index": 0})
+    got, scene = render_color(path, 32)
+    want, _ = render_color(oracle, 32)
+    np.testing.assert_array_equal(scene.draws[0].mesh.uvs, QUAD_UVS)
+    assert scene.draws[0].texture is not None
+    assert np.array_equal(got, want)
+    for q, expected in enumerate([TEXELS[0, 0], TEXELS[0, 1], TEXELS[1, 0], TEXELS[1, 1]]):
+        np.testing.assert_allclose(quadrant_colors(got)[q], expected, atol=1e-6)
+
+
+def test_gltf_missing_texcoord_n_draws_without_the_texture(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    path = textured_variant(tmp_path, "uv2.gltf", [QUAD_UVS, QUAD_UVS], {"index": 0, "texCoord": 2})
+    with pytest.warns(UserWarning, match=r"meshes\[0\]\.primitives\[0\] has no TEXCOORD_2 but its material "
+                                         r"'checker' \(materials\[0\]\) has a baseColorTexture; "
+                                         r"drawn without the texture"):
+        scene, _ = mr.load_scene(path)
+    assert scene.draws[0].texture is None
+
+
+def test_gltf_texcoord_n_with_the_wrong_count_is_an_error(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    path = textured_variant(tmp_path, "uv1_count.gltf", [QUAD_UVS, QUAD_UVS], {"index": 0, "texCoord": 1})
+    doc = json.loads(path.read_text())
+    doc["accessors"][-1]["count"] = 3
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=r"uv1_count\.gltf: .*TEXCOORD_1 \(accessor 4\): TEXCOORD_1 has 3 elements"):
+        mr.load_scene(path)
+
+
+def spec_uv_transform(uvs, offset=(0.0, 0.0), rotation=0.0, scale=(1.0, 1.0)):
+    """KHR_texture_transform, written out here as the oracle: uv' = T(offset) R(rotation) S(scale) uv
+    with R = [[cos, sin], [-sin, cos]] (the extension's example: offset (0, 1), rotation pi/2, scale
+    1/2 maps the unit square onto the image's lower-left quadrant, v down)."""
+    u, v = np.float64(uvs).T * np.float64(scale)[:, None]
+    c, s = math.cos(rotation), math.sin(rotation)
+    return np.float32(np.stack([c * u + s * v + offset[0], -s * u + c * v + offset[1]], axis=1))
+
+
+TRANSFORMS = {
+    "offset": dict(offset=[0.5, 0.25]),
+    "scale": dict(scale=[2.0, -3.0]),
+    "rotation": dict(rotation=0.7),
+    "all": dict(offset=[-0.3, 1.2], rotation=-2.1, scale=[1.5, 0.75]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(TRANSFORMS))
+def test_gltf_texture_transform_equals_uvs_transformed_by_the_spec(tmp_path, name):
+    write_texture(tmp_path / "checker.png")
+    transform = TRANSFORMS[name]
+    info = {"index": 0, "extensions": {"KHR_texture_transform": transform}}
+    path = textured_variant(tmp_path, "transform.gltf", [QUAD_UVS], info,
+                            extra={"extensionsUsed": ["KHR_texture_transform"]})
+    expected_uvs = spec_uv_transform(QUAD_UVS, **transform)
+    oracle = textured_variant(tmp_path, "transformed_uvs.gltf", [expected_uvs], {"index": 0})
+    got, scene = render_color(path, 32)
+    want, _ = render_color(oracle, 32)
+    np.testing.assert_allclose(scene.draws[0].mesh.uvs, expected_uvs, rtol=0, atol=1e-6)
+    assert np.array_equal(got, want)
+
+
+def test_gltf_texture_transform_follows_the_extensions_example(tmp_path):
+    # The extension's README: offset (0, 1), rotation pi/2, scale 1/2 "utilizes only the lower left
+    # quadrant of the source image": the 2x2 checker's blue texel fills the quad.
+    write_texture(tmp_path / "checker.png")
+    transform = {"offset": [0, 1], "rotation": math.pi / 2, "scale": [0.5, 0.5]}
+    info = {"index": 0, "extensions": {"KHR_texture_transform": transform}}
+    got, _ = render_color(textured_variant(tmp_path, "example.gltf", [QUAD_UVS], info), 32)
+    inner = got[2:-2, 2:-2].reshape(-1, 4)
+    np.testing.assert_allclose(inner, np.tile(TEXELS[1, 0], (len(inner), 1)), atol=1e-6)
+
+
+def test_gltf_texture_transform_texcoord_overrides_the_texture_infos(tmp_path):
+    write_texture(tmp_path / "checker.png")
+    flat = np.full((4, 2), 0.9, np.float32)
+    transform = {"texCoord": 1, "scale": [0.5, 0.5]}
+    info = {"index": 0, "texCoord": 0, "extensions": {"KHR_texture_transform": transform}}
+    path = textured_variant(tmp_path, "override.gltf", [flat, QUAD_UVS], info)
+    got, scene = render_color(path, 32)
+    np.testing.assert_allclose(scene.draws[0].mesh.uvs, spec_uv_transform(QUAD_UVS, scale=(0.5, 0.5)))
+    inner = got[2:-2, 2:-2].reshape(-1, 4)
+    np.testing.assert_allclose(inner, np.tile(TEXELS[0, 0], (len(inner), 1)), atol=1e-6)  # all the red texel
+
+
+def test_gltf_texture_transform_does_not_leak_to_primitives_sharing_its_accessors(tmp_path):
+    # One mesh with two primitives on the same accessors, one material transformed and one not, and
+    # two nodes drawing that mesh: every draw gets its own material's uvs.
+    write_texture(tmp_path / "checker.png")
+    transform = {"offset": [0.25, 0.5]}
+    path = textured_variant(tmp_path, "shared.gltf", [QUAD_UVS],
+                            {"index": 0, "extensions": {"KHR_texture_transform": transform}})
+    doc = json.loads(path.read_text())
+    plain = dict(doc["materials"][0], name="plain",
+                 pbrMetallicRoughness={"baseColorTexture": {"index": 0}})
+    doc["materials"].append(plain)
+    prim = doc["meshes"][0]["primitives"][0]
+    doc["meshes"][0]["primitives"] = [prim, dict(prim, material=1), prim]
+    doc["nodes"].append({"mesh": 0, "translation": [0, 0, 1]})
+    doc["scenes"][0]["nodes"].append(len(doc["nodes"]) - 1)
+    path.write_text(json.dumps(doc))
+    scene, _ = mr.load_scene(path)
+    assert len(scene.draws) == 6
+    # The second node's draws share the first node's meshes; the primitives do not share one.
+    assert all(scene.draws[i].mesh is scene.draws[i + 3].mesh for i in range(3))
+    assert len({id(d.mesh) for d in scene.draws}) == 3
+    moved = spec_uv_transform(QUAD_UVS, offset=(0.25, 0.5))
+    for d, uvs in zip(scene.draws, [moved, QUAD_UVS, moved] * 2):
+        np.testing.assert_allclose(d.mesh.uvs, uvs, rtol=0, atol=1e-6)
+
+
+TRANSFORM_ERRORS = {
+    "offset_length": ({"offset": [0.5]}, r"KHR_texture_transform offset must be 2 finite numbers"),
+    "scale_length": ({"scale": [1, 2, 3]}, r"KHR_texture_transform scale must be 2 finite numbers"),
+    "scale_type": ({"scale": [1, "x"]}, r"KHR_texture_transform scale must be 2 finite numbers"),
+    "offset_object": ({"offset": {"u": 1, "v": 2}}, r"KHR_texture_transform offset must be 2 finite numbers"),
+    "rotation_type": ({"rotation": [1]}, r"KHR_texture_transform rotation must be a finite number"),
+    "rotation_string": ({"rotation": "0.5"}, r"KHR_texture_transform rotation must be a finite number"),
+    "texcoord": ({"texCoord": -1}, r"KHR_texture_transform texCoord must be an integer >= 0"),
+    "texcoord_real": ({"texCoord": 1.5}, r"KHR_texture_transform texCoord must be an integer >= 0"),
+}
+# (Non-finite values cannot reach the loader: JSON has none, and tinygltf's parser rejects 1e999.)
+
+
+@pytest.mark.parametrize("case", sorted(TRANSFORM_ERRORS))
+def test_gltf_bad_texture_transform_is_an_error_naming_the_material(tmp_path, case):
+    write_texture(tmp_path / "checker.png")
+    transform, problem = TRANSFORM_ERRORS[case]
+    info = {"index": 0, "extensions": {"KHR_texture_transform": transform}}
+    path = textured_variant(tmp_path, "bad_transform.gltf", [QUAD_UVS], info)
+    with pytest.raises(OSError, match=r"bad_transform\.gltf: material 'checker' \(materials\[0\]\): " + problem):
+        mr.load_scene(path)
+
+
+# extensionsRequired: an extension the loader cannot honour stops the load with a message naming it.
+
+@pytest.mark.parametrize("extension", ["KHR_draco_mesh_compression", "EXT_meshopt_compression",
+                                       "KHR_texture_basisu"])
+def test_gltf_required_extension_that_is_not_supported_is_named(tmp_path, extension):
+    path = write_gltf(tmp_path / "required.gltf")
+    doc = json.loads(path.read_text())
+    doc["extensionsUsed"] = doc["extensionsRequired"] = ["KHR_texture_transform", extension]
+    if extension == "KHR_draco_mesh_compression":  # as compressed files are: accessors without views
+        for a in doc["accessors"]:
+            del a["bufferView"]
+    elif extension == "EXT_meshopt_compression":  # a fallback buffer without data
+        doc["buffers"].append({"byteLength": 64})
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=rf"required\.gltf: the file requires the glTF extension '{extension}', "
+                                      r"which this loader does not support"):
+        mr.load_scene(path)
+
+
+@pytest.mark.parametrize("extension", ["KHR_texture_transform", "KHR_materials_unlit", "KHR_mesh_quantization"])
+def test_gltf_required_extension_that_is_supported_loads(tmp_path, extension):
+    path = write_gltf(tmp_path / "required_ok.gltf")
+    doc = json.loads(path.read_text())
+    doc["extensionsUsed"] = doc["extensionsRequired"] = [extension]
+    path.write_text(json.dumps(doc))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scene, _ = mr.load_scene(path)
+    assert len(scene.draws[0].mesh.triangles) == 1
+
+
+def test_gltf_mesh_quantization_texcoords(tmp_path):
+    # KHR_mesh_quantization allows TEXCOORD_n as (normalized or not) byte/short and unnormalized
+    # unsigned byte/short; the values are the integers (normalized: divided by 127 / 32767).
+    write_texture(tmp_path / "checker.png")
+    cases = [(5120, True, [0, 0, 127, 0, 127, 127, 0, 127], np.int8),
+             (5122, True, [0, 0, 32767, 0, 32767, 32767, 0, 32767], np.int16),
+             (5120, False, [0, 0, 1, 0, 1, 1, 0, 1], np.int8),
+             (5121, False, [0, 0, 1, 0, 1, 1, 0, 1], np.uint8),
+             (5122, False, [0, 0, 1, 0, 1, 1, 0, -1], np.int16),
+             (5123, False, [0, 0, 1, 0, 1, 1, 0, 1], np.uint16)]
+    for k, (component, normalized, values, dtype) in enumerate(cases):
+        path = textured_variant(tmp_path, f"quantized{k}.gltf", [QUAD_UVS], {"index": 0},
+                                extra={"extensionsUsed": ["KHR_mesh_quantization"],
+                                       "extensionsRequired": ["KHR_mesh_quantization"]})
+        doc = json.loads(path.read_text())
+        data = np.asarray(values, dtype=dtype).tobytes()
+        data += b"\0" * (-len(data) % 4)
+        buf = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": len(buf), "byteLength": len(data)})
+        buf += data
+        doc["buffers"][0] = {"byteLength": len(buf), "uri": data_uri(buf)}
+        doc["accessors"][-1] = {"bufferView": len(doc["bufferViews"]) - 1, "componentType": component,
+                                "normalized": normalized, "count": 4, "type": "VEC2"}
+        path.write_text(json.dumps(doc))
+        scene, _ = mr.load_scene(path)
+        scale = (127.0 if dtype == np.int8 else 32767.0) if normalized else 1.0
+        np.testing.assert_allclose(scene.draws[0].mesh.uvs, np.float32(values).reshape(4, 2) / scale,
+                                   err_msg=str((component, normalized)))
+        assert scene.draws[0].texture is not None

@@ -3,6 +3,7 @@
 #include "mipraster/io/scene_file.hpp"
 
 #include "file_extension.hpp"
+#include "mipraster/core/memory_limit.hpp"
 #include "mipraster/io/texture_file.hpp"
 
 #include <algorithm>
@@ -343,7 +344,8 @@ std::string percent_decode(const std::string& uri) {
 }
 
 /// Reads an accessor's elements as doubles (normalized integers mapped to [0, 1] / [−1, 1]),
-/// after checking that every byte it names lies inside its buffer.
+/// after checking that every byte it names lies inside its buffer. A sparse accessor is
+/// materialized first into an owned, tightly packed copy, which is then read like a dense one.
 class AccessorReader {
 public:
     AccessorReader(const tinygltf::Model& model, int index, const std::string& path, const std::string& what)
@@ -352,8 +354,7 @@ public:
             fail(path, what + ": accessor " + std::to_string(index) + " does not exist (the file has " +
                            std::to_string(model.accessors.size()) + ")");
         const tinygltf::Accessor& a = model.accessors[index];
-        what_ = what + " (accessor " + std::to_string(index) + ")";
-        if (a.sparse.isSparse) fail(path, what_ + ": sparse accessors are not supported");
+        what_ = what + " (accessor " + std::to_string(index) + (a.name.empty() ? "" : " '" + a.name + "'") + ")";
         count_ = a.count;
         components_ = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
         component_type_ = a.componentType;
@@ -363,30 +364,15 @@ public:
             fail(path, what_ + ": unsupported type " + std::to_string(a.type) + " / component type " +
                            std::to_string(a.componentType));
         if (count_ > kMaxElements) fail(path, what_ + ": absurd count " + std::to_string(count_));
-        if (count_ == 0) return;
-        if (a.bufferView < 0 || static_cast<std::size_t>(a.bufferView) >= model.bufferViews.size())
-            fail(path, what_ + ": buffer view " + std::to_string(a.bufferView) + " does not exist");
-        const tinygltf::BufferView& view = model.bufferViews[a.bufferView];
-        if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size())
-            fail(path, what_ + ": buffer " + std::to_string(view.buffer) + " does not exist");
-        const std::vector<unsigned char>& buffer = model.buffers[view.buffer].data;
-        const std::size_t element = static_cast<std::size_t>(components_) * static_cast<std::size_t>(size_);
-        stride_ = view.byteStride ? view.byteStride : element;
-        if (stride_ < element || stride_ > 252 + element)
-            fail(path, what_ + ": byte stride " + std::to_string(view.byteStride) + " is invalid");
-        // All sizes below are bounded: count ≤ 2^32 and stride ≤ 256, so no product overflows.
-        if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
-            fail(path, what_ + ": buffer view " + std::to_string(a.bufferView) + " (offset " +
-                           std::to_string(view.byteOffset) + ", length " + std::to_string(view.byteLength) +
-                           ") lies outside its buffer of " + std::to_string(buffer.size()) + " bytes");
-        if (a.byteOffset > view.byteLength)
-            fail(path, what_ + ": byte offset " + std::to_string(a.byteOffset) + " lies outside its buffer view");
-        const std::size_t needed = a.byteOffset + (count_ - 1) * stride_ + element;
-        if (needed > view.byteLength)
-            fail(path, what_ + ": " + std::to_string(count_) + " elements need " + std::to_string(needed) +
-                           " bytes, its buffer view has " + std::to_string(view.byteLength));
-        data_ = buffer.data() + view.byteOffset + a.byteOffset;
+        if (a.sparse.isSparse) {
+            materialize_sparse(model, a);
+        } else if (count_ > 0) {
+            read_dense(model, a);
+        }
     }
+    // data_ may point into owned_: a copy would point into the original's.
+    AccessorReader(const AccessorReader&) = delete;
+    AccessorReader& operator=(const AccessorReader&) = delete;
 
     std::size_t count() const { return count_; }
     int components() const { return components_; }
@@ -432,7 +418,107 @@ private:
     double scaled(double v, double max) const { return normalized_ ? v / max : v; }
     double signed_scaled(double v, double max) const { return normalized_ ? std::max(v / max, -1.0) : v; }
 
+    std::size_t element_size() const { return static_cast<std::size_t>(components_) * static_cast<std::size_t>(size_); }
+
+    /// Buffer view `index`, after checking that it and its buffer exist and that it lies inside the
+    /// buffer; `part` ("" or "sparse indices: " / "sparse values: ") says which part of the accessor
+    /// uses it.
+    const tinygltf::BufferView& checked_view(const tinygltf::Model& model, int index, const std::string& part) const {
+        if (index < 0 || static_cast<std::size_t>(index) >= model.bufferViews.size())
+            fail(path_, what_ + ": " + part + "buffer view " + std::to_string(index) + " does not exist");
+        const tinygltf::BufferView& view = model.bufferViews[index];
+        if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size())
+            fail(path_, what_ + ": " + part + "buffer " + std::to_string(view.buffer) + " does not exist");
+        const std::size_t buffer_size = model.buffers[view.buffer].data.size();
+        if (view.byteOffset > buffer_size || view.byteLength > buffer_size - view.byteOffset)
+            fail(path_, what_ + ": " + part + "buffer view " + std::to_string(index) + " (offset " +
+                            std::to_string(view.byteOffset) + ", length " + std::to_string(view.byteLength) +
+                            ") lies outside its buffer of " + std::to_string(buffer_size) + " bytes");
+        return view;
+    }
+
+    /// The bytes [offset, offset + needed) of buffer view `index`, which hold `elements` elements,
+    /// after checking that they lie inside the view (and the view inside its buffer).
+    const unsigned char* view_range(const tinygltf::Model& model, int index, std::size_t offset, std::size_t needed,
+                                    std::size_t elements, const std::string& part) const {
+        const tinygltf::BufferView& view = checked_view(model, index, part);
+        if (offset > view.byteLength || needed > view.byteLength - offset)
+            fail(path_, what_ + ": " + part + std::to_string(elements) + " elements need " + std::to_string(needed) +
+                            " bytes from byte offset " + std::to_string(offset) + ", buffer view " +
+                            std::to_string(index) + " has " + std::to_string(view.byteLength));
+        return model.buffers[view.buffer].data.data() + view.byteOffset + offset;
+    }
+
+    /// Points data_ at the accessor's count_ (> 0) elements in its buffer view, stride_ apart.
+    void read_dense(const tinygltf::Model& model, const tinygltf::Accessor& a) {
+        const tinygltf::BufferView& view = checked_view(model, a.bufferView, "");
+        const std::size_t element = element_size();
+        stride_ = view.byteStride ? view.byteStride : element;
+        if (stride_ < element || stride_ > 252 + element)
+            fail(path_, what_ + ": byte stride " + std::to_string(view.byteStride) + " is invalid");
+        // count ≤ 2^32 and stride ≤ 256: the product does not overflow.
+        data_ = view_range(model, a.bufferView, a.byteOffset, (count_ - 1) * stride_ + element, count_, "");
+    }
+
+    /// A sparse accessor (glTF 2.0 §3.6.2.3) copied into owned_, tightly packed: the base values
+    /// from its buffer view (zeros when it has none), then element sparse.indices[k] replaced by
+    /// sparse.values[k]. The indices must be unsigned byte/short/int, strictly increasing and below
+    /// count; both arrays are tightly packed in their views.
+    void materialize_sparse(const tinygltf::Model& model, const tinygltf::Accessor& a) {
+        const auto& sparse = a.sparse;
+        if (sparse.count < 1)
+            fail(path_, what_ + ": sparse count " + std::to_string(sparse.count) + " must be at least 1");
+        const std::size_t n = static_cast<std::size_t>(sparse.count);
+        if (n > count_)
+            fail(path_, what_ + ": sparse count " + std::to_string(n) + " is larger than the accessor's count " +
+                            std::to_string(count_));
+        const int index_type = sparse.indices.componentType;
+        if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            fail(path_, what_ + ": sparse indices must be unsigned byte, short or int, got component type " +
+                            std::to_string(index_type));
+        if (sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0)
+            fail(path_, what_ + ": sparse byte offsets must not be negative");
+
+        const std::size_t element = element_size();
+        // Without a base view, a few bytes of JSON can ask for count × element bytes of zeros.
+        check_memory(static_cast<std::uint64_t>(count_) * element, path_ + ": " + what_ + " (a sparse accessor)");
+        owned_.assign(count_ * element, 0);
+        if (a.bufferView >= 0) {
+            read_dense(model, a);
+            for (std::size_t i = 0; i < count_; ++i) std::memcpy(&owned_[i * element], data_ + i * stride_, element);
+        }
+        const std::size_t index_size = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(index_type));
+        const unsigned char* indices = view_range(model, sparse.indices.bufferView, sparse.indices.byteOffset,
+                                                  n * index_size, n, "sparse indices: ");
+        const unsigned char* values = view_range(model, sparse.values.bufferView, sparse.values.byteOffset,
+                                                 n * element, n, "sparse values: ");
+        for (std::size_t k = 0; k < n; ++k) {
+            const std::uint64_t i = unsigned_at(indices + k * index_size, index_type);
+            if (i >= count_)
+                fail(path_, what_ + ": sparse index " + std::to_string(i) + " (element " + std::to_string(k) +
+                                ") is out of range (the accessor's count is " + std::to_string(count_) + ")");
+            if (k > 0 && i <= unsigned_at(indices + (k - 1) * index_size, index_type))
+                fail(path_, what_ + ": sparse indices are not strictly increasing: " +
+                                std::to_string(unsigned_at(indices + (k - 1) * index_size, index_type)) +
+                                " is followed by " + std::to_string(i) + " (element " + std::to_string(k) + ")");
+            std::memcpy(&owned_[i * element], values + k * element, element);
+        }
+        data_ = owned_.data();
+        stride_ = element;
+    }
+
+    /// The unsigned integer of component type `type` (unsigned byte, short or int) at p.
+    static std::uint64_t unsigned_at(const unsigned char* p, int type) {
+        switch (type) {
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return load<std::uint8_t>(p);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return load<std::uint16_t>(p);
+            default: return load<std::uint32_t>(p);
+        }
+    }
+
     std::string path_, what_;
+    std::vector<unsigned char> owned_;  // a sparse accessor's materialized elements
     const unsigned char* data_ = nullptr;
     std::size_t count_ = 0, stride_ = 0;
     int components_ = 0, component_type_ = 0, size_ = 0;
@@ -468,6 +554,33 @@ glm::dmat4 node_matrix(const tinygltf::Node& node, const std::string& path, int 
     return t * r * s;
 }
 
+/// Whether a primitive mode is one of triangles (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN; −1: not
+/// given, TRIANGLES) rather than POINTS, LINES, LINE_LOOP, LINE_STRIP or a value glTF does not define.
+bool draws_triangles(int mode) {
+    return mode == -1 || mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
+           mode == TINYGLTF_MODE_TRIANGLE_FAN;
+}
+
+/// Which texture coordinate set (TEXCOORD_<set>) becomes a primitive's uvs, and the affine map
+/// that KHR_texture_transform applies to it: uv' = T(offset)·R(rotation)·S(scale)·uv.
+struct UvChoice {
+    int set = 0;
+    bool transformed = false;  // (the identity is skipped: it would turn an infinite v into NaN u)
+    glm::dvec2 offset{0.0}, scale{1.0};
+    double rotation = 0.0;
+
+    /// The transformed uv. R is [[cos, sin], [−sin, cos]] (row by row), the rotation Khronos'
+    /// sample models, Blender and three.js use: the extension's GLSL listing fills a column-major
+    /// mat3 with the same numbers, which reads as the transpose (KhronosGroup/glTF issue #1563);
+    /// its example (offset (0, 1), rotation π/2, scale ½ selects the lower-left quadrant) agrees
+    /// with this form only.
+    glm::vec2 apply(glm::dvec2 uv) const {
+        const double c = std::cos(rotation), s = std::sin(rotation);
+        const glm::dvec2 scaled = uv * scale;
+        return glm::vec2(c * scaled.x + s * scaled.y + offset.x, -s * scaled.x + c * scaled.y + offset.y);
+    }
+};
+
 struct GltfLoader {
     const tinygltf::Model& model;
     const std::string& path;
@@ -478,9 +591,15 @@ struct GltfLoader {
     std::set<std::string> warned;                                     // warnings given once
     std::size_t skipped_primitives = 0;
     std::vector<bool> on_path;  // nodes on the current root-to-node path (cycle detection)
+    bool quantized = false;     // the file uses KHR_mesh_quantization (integer texture coordinates)
 
     GltfLoader(const tinygltf::Model& m, const std::string& p, const EmbeddedImages& e)
-        : model(m), path(p), embedded(e), on_path(m.nodes.size(), false) {}
+        : model(m), path(p), embedded(e), on_path(m.nodes.size(), false) {
+        const auto lists = [&](const std::vector<std::string>& names) {
+            return std::find(names.begin(), names.end(), "KHR_mesh_quantization") != names.end();
+        };
+        quantized = lists(m.extensionsUsed) || lists(m.extensionsRequired);
+    }
 
     void warn_once(const std::string& message) {
         if (warned.insert(message).second) scene.warnings.push_back(path + ": " + message);
@@ -517,19 +636,12 @@ struct GltfLoader {
         }
         if (!mat.doubleSided) draw.state.cull = CullMode::back;
 
-        // Base colour texture: TEXCOORD_0 only.
+        // Base colour texture, on the uvs base_color_uvs chose (and transformed) for the mesh.
         const tinygltf::TextureInfo& info = mat.pbrMetallicRoughness.baseColorTexture;
         if (info.index < 0) return;
         if (static_cast<std::size_t>(info.index) >= model.textures.size())
             fail(path, name + ": baseColorTexture index " + std::to_string(info.index) +
                            " does not exist (the file has " + std::to_string(model.textures.size()) + " textures)");
-        if (info.texCoord != 0) {
-            warn_once(name + ": baseColorTexture uses TEXCOORD_" + std::to_string(info.texCoord) +
-                      "; only TEXCOORD_0 is supported, so it is drawn without the texture");
-            return;
-        }
-        if (info.extensions.count("KHR_texture_transform"))
-            warn_once(name + ": KHR_texture_transform is not supported; the texture is drawn untransformed");
         const tinygltf::Texture& tex = model.textures[info.index];
         const std::string tex_what = "textures[" + std::to_string(info.index) + "]";
         Sampler sampler = sampler_of(tex.sampler, tex_what);  // checks the index even when unused below
@@ -537,7 +649,8 @@ struct GltfLoader {
             fail(path, tex_what + ": source image " + std::to_string(tex.source) + " does not exist (the file has " +
                            std::to_string(model.images.size()) + " images)");
         if (!draw.mesh->has_uvs()) {
-            warn_once(prim_what + " has no TEXCOORD_0 but its " + name +
+            warn_once(prim_what + " has no TEXCOORD_" + std::to_string(base_color_uvs(prim.material).set) +
+                      " but its " + name +
                       " has a baseColorTexture; drawn without the texture");
             return;
         }
@@ -672,6 +785,114 @@ struct GltfLoader {
                model.materials[material].alphaMode == "BLEND";
     }
 
+    /// The primitive's vertices in drawing order: its indices (any unsigned component type, each
+    /// checked against the vertex count), or 0, 1, …, vertex_count − 1 when it has none.
+    std::vector<std::uint32_t> vertex_sequence(const tinygltf::Primitive& prim, std::size_t vertex_count,
+                                               const std::string& what) const {
+        std::vector<std::uint32_t> sequence;
+        if (prim.indices < 0) {
+            sequence.resize(vertex_count);
+            for (std::size_t i = 0; i < vertex_count; ++i) sequence[i] = static_cast<std::uint32_t>(i);
+            return sequence;
+        }
+        const AccessorReader idx(model, prim.indices, path, what + " indices");
+        if (idx.components() != 1) fail(path, idx.what() + ": indices must be SCALAR");
+        sequence.resize(idx.count());
+        for (std::size_t i = 0; i < idx.count(); ++i) {
+            const std::uint64_t v = idx.get_index(i);
+            if (v >= vertex_count)
+                fail(path, idx.what() + ": index " + std::to_string(v) + " (element " + std::to_string(i) +
+                               ") is out of range (" + std::to_string(vertex_count) + " vertices)");
+            sequence[i] = static_cast<std::uint32_t>(v);
+        }
+        return sequence;
+    }
+
+    /// The triangles of a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN vertex sequence v, in the order
+    /// of the glTF 2.0 spec (§3.7.2.1): strip triangle i is (v[i], v[i+1+i%2], v[i+2−i%2]), i.e. odd
+    /// triangles swap their last two vertices so that all keep the strip's winding (back-face
+    /// culling depends on it); fan triangle i is (v[i+1], v[i+2], v[0]). Leftover vertices (a
+    /// TRIANGLES count that is no multiple of 3) and strips or fans of fewer than 3 vertices give
+    /// a warning.
+    std::vector<glm::uvec3> assemble_triangles(int mode, const std::vector<std::uint32_t>& v,
+                                               const std::string& what) {
+        const std::size_t n = v.size();
+        std::vector<glm::uvec3> triangles;
+        if (mode == TINYGLTF_MODE_TRIANGLES || mode == -1) {
+            if (n % 3 != 0)
+                scene.warnings.push_back(path + ": " + what + ": vertex count " + std::to_string(n) +
+                                         " is not a multiple of 3; the last vertices are ignored");
+            triangles.resize(n / 3);
+            for (std::size_t t = 0; t < triangles.size(); ++t) triangles[t] = {v[3 * t], v[3 * t + 1], v[3 * t + 2]};
+            return triangles;
+        }
+        const bool strip = mode == TINYGLTF_MODE_TRIANGLE_STRIP;
+        if (n < 3) {
+            scene.warnings.push_back(path + ": " + what + ": a triangle " + (strip ? "strip" : "fan") + " of " +
+                                     std::to_string(n) + " vertices has no triangle");
+            return triangles;
+        }
+        triangles.resize(n - 2);
+        for (std::size_t i = 0; i < n - 2; ++i)
+            triangles[i] = strip ? glm::uvec3(v[i], v[i + 1 + i % 2], v[i + 2 - i % 2])
+                                 : glm::uvec3(v[i + 1], v[i + 2], v[0]);
+        return triangles;
+    }
+
+    /// The texture coordinate set the base colour texture of material `material` reads
+    /// (baseColorTexture.texCoord, or its KHR_texture_transform's texCoord) and that extension's
+    /// transform; set 0 and the identity for no material, an untextured one or one that does not
+    /// exist (apply_material reports that). Malformed transform values are an error naming the
+    /// material.
+    UvChoice base_color_uvs(int material) const {
+        UvChoice choice;
+        if (material < 0 || static_cast<std::size_t>(material) >= model.materials.size()) return choice;
+        const tinygltf::Material& mat = model.materials[material];
+        const tinygltf::TextureInfo& info = mat.pbrMetallicRoughness.baseColorTexture;
+        if (info.index < 0) return choice;
+        choice.set = info.texCoord;
+        const auto ext = info.extensions.find("KHR_texture_transform");
+        if (ext == info.extensions.end()) return choice;
+
+        choice.transformed = true;
+        const std::string what = material_name(mat, material) + ": KHR_texture_transform ";
+        const tinygltf::Value& t = ext->second;  // (an object: tinygltf drops extensions that are not)
+        const auto finite_number = [](const tinygltf::Value& v) {
+            return v.IsNumber() && std::isfinite(v.GetNumberAsDouble());
+        };
+        const auto pair = [&](const char* key, glm::dvec2 value) {
+            if (!t.Has(key)) return value;
+            const tinygltf::Value& v = t.Get(key);
+            if (!v.IsArray() || v.ArrayLen() != 2 || !finite_number(v.Get(0)) || !finite_number(v.Get(1)))
+                fail(path, what + key + " must be 2 finite numbers");
+            return glm::dvec2(v.Get(0).GetNumberAsDouble(), v.Get(1).GetNumberAsDouble());
+        };
+        choice.offset = pair("offset", choice.offset);
+        choice.scale = pair("scale", choice.scale);
+        if (t.Has("rotation")) {
+            if (!finite_number(t.Get("rotation"))) fail(path, what + "rotation must be a finite number");
+            choice.rotation = t.Get("rotation").GetNumberAsDouble();
+        }
+        if (t.Has("texCoord")) {  // overrides the textureInfo's
+            const tinygltf::Value& v = t.Get("texCoord");
+            if (!v.IsInt() || v.GetNumberAsInt() < 0) fail(path, what + "texCoord must be an integer >= 0");
+            choice.set = v.GetNumberAsInt();
+        }
+        return choice;
+    }
+
+    /// Whether a TEXCOORD_n component type is allowed: float or normalized unsigned byte/short
+    /// (glTF 2.0), and in files that use KHR_mesh_quantization also byte and short (normalized or
+    /// not) and unnormalized unsigned byte/short, read as their integer values.
+    bool texcoord_type_allowed(int type, bool normalized) const {
+        if (type == TINYGLTF_COMPONENT_TYPE_FLOAT) return true;
+        const bool small_unsigned =
+            type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+        if (small_unsigned && normalized) return true;
+        return quantized &&
+               (small_unsigned || type == TINYGLTF_COMPONENT_TYPE_BYTE || type == TINYGLTF_COMPONENT_TYPE_SHORT);
+    }
+
     std::shared_ptr<Mesh> primitive_mesh(int mesh_index, int prim_index) {
         const auto key = std::make_pair(mesh_index, prim_index);
         if (auto it = mesh_cache.find(key); it != mesh_cache.end()) return it->second;
@@ -709,21 +930,31 @@ struct GltfLoader {
             }
         }
 
-        // Texture coordinates: float or normalized unsigned byte/short (glTF's uv convention is ours).
-        if (const auto uv_it = prim.attributes.find("TEXCOORD_0"); uv_it != prim.attributes.end()) {
-            const AccessorReader uv(model, uv_it->second, path, what + " TEXCOORD_0");
-            if (uv.components() != 2) fail(path, uv.what() + ": TEXCOORD_0 must be VEC2");
+        // Texture coordinates: the set the material's base colour texture reads (TEXCOORD_0 when it
+        // has none), with its KHR_texture_transform applied here (an affine map of the uvs commutes
+        // with perspective-correct interpolation, so this is exact); float or normalized unsigned
+        // byte/short (glTF's uv convention is ours). The material is this primitive's own, as is
+        // this mesh (cached by (mesh, primitive)), so neither choice reaches another draw.
+        const UvChoice choice = base_color_uvs(prim.material);
+        const std::string uv_name = "TEXCOORD_" + std::to_string(choice.set);
+        if (const auto uv_it = prim.attributes.find(uv_name); uv_it != prim.attributes.end()) {
+            const AccessorReader uv(model, uv_it->second, path, what + " " + uv_name);
+            if (uv.components() != 2) fail(path, uv.what() + ": " + uv_name + " must be VEC2");
             const int ct = uv.component_type();
-            if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
-                !((ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
-                  uv.normalized()))
-                fail(path, uv.what() + ": TEXCOORD_0 must be float or normalized unsigned byte/short, got component type " +
-                               std::to_string(ct) + (uv.normalized() ? " (normalized)" : ""));
+            if (!texcoord_type_allowed(ct, uv.normalized()))
+                fail(path, uv.what() + ": " + uv_name + " must be float or normalized unsigned byte/short" +
+                               (quantized ? " (or byte/short, normalized or not, and unsigned byte/short with "
+                                            "KHR_mesh_quantization)"
+                                          : "") +
+                               ", got component type " + std::to_string(ct) + (uv.normalized() ? " (normalized)" : ""));
             if (uv.count() != pos.count())
-                fail(path, uv.what() + ": TEXCOORD_0 has " + std::to_string(uv.count()) + " elements, POSITION " +
+                fail(path, uv.what() + ": " + uv_name + " has " + std::to_string(uv.count()) + " elements, POSITION " +
                                std::to_string(pos.count()));
             mesh->uvs.resize(uv.count());
-            for (std::size_t i = 0; i < uv.count(); ++i) mesh->uvs[i] = glm::vec2(uv.get(i, 0), uv.get(i, 1));
+            for (std::size_t i = 0; i < uv.count(); ++i) {
+                const glm::dvec2 value(uv.get(i, 0), uv.get(i, 1));
+                mesh->uvs[i] = choice.transformed ? choice.apply(value) : glm::vec2(value);
+            }
         }
 
         // Normals: float (or normalized signed byte/short, as KHR_mesh_quantization allows).
@@ -743,27 +974,8 @@ struct GltfLoader {
                 mesh->normals[i] = glm::vec3(nrm.get(i, 0), nrm.get(i, 1), nrm.get(i, 2));
         }
 
-        // Indices (any unsigned component type), or the vertices in order.
-        if (prim.indices >= 0) {
-            const AccessorReader idx(model, prim.indices, path, what + " indices");
-            if (idx.components() != 1) fail(path, idx.what() + ": indices must be SCALAR");
-            if (idx.count() % 3 != 0)
-                scene.warnings.push_back(path + ": " + what + ": index count " + std::to_string(idx.count()) +
-                                         " is not a multiple of 3; the last indices are ignored");
-            mesh->triangles.resize(idx.count() / 3);
-            for (std::size_t t = 0; t < mesh->triangles.size(); ++t)
-                for (int c = 0; c < 3; ++c) {
-                    const std::uint64_t v = idx.get_index(3 * t + c);
-                    if (v >= pos.count())
-                        fail(path, idx.what() + ": index " + std::to_string(v) + " of triangle " + std::to_string(t) +
-                                       " is out of range (" + std::to_string(pos.count()) + " vertices)");
-                    mesh->triangles[t][c] = static_cast<std::uint32_t>(v);
-                }
-        } else {
-            mesh->triangles.resize(pos.count() / 3);
-            for (std::size_t t = 0; t < mesh->triangles.size(); ++t)
-                mesh->triangles[t] = glm::uvec3(3 * t, 3 * t + 1, 3 * t + 2);
-        }
+        // Triangles: the vertex sequence (the indices, or the vertices in order) assembled by mode.
+        mesh->triangles = assemble_triangles(prim.mode, vertex_sequence(prim, pos.count(), what), what);
         mesh->validate(path + " " + what);
         scene.meshes.push_back(mesh);
         mesh_cache.emplace(key, mesh);
@@ -790,7 +1002,7 @@ struct GltfLoader {
             const tinygltf::Mesh& m = model.meshes[node.mesh];
             for (std::size_t p = 0; p < m.primitives.size(); ++p) {
                 const tinygltf::Primitive& prim = m.primitives[p];
-                if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) {
+                if (!draws_triangles(prim.mode)) {
                     ++skipped_primitives;
                     continue;
                 }
@@ -849,6 +1061,26 @@ struct GltfLoader {
     }
 };
 
+/// The glTF extensions a file may list in extensionsRequired and still load as its author meant:
+/// those this loader reads (KHR_texture_transform on the base colour texture; KHR_mesh_quantization's
+/// integer POSITION, NORMAL and TEXCOORD_n) and those that do not change what it draws
+/// (KHR_materials_unlit: its renders are unlit anyway).
+const std::set<std::string> kSupportedRequiredExtensions = {"KHR_materials_unlit", "KHR_mesh_quantization",
+                                                            "KHR_texture_transform"};
+
+/// A file that requires another extension (compressed geometry, other image formats, …) cannot
+/// be drawn right: an error naming it. tinygltf only records the list, and without this the load
+/// failed later on what the extension changes, e.g. "accessor[1] invalid bufferView" for Draco.
+void check_required_extensions(const tinygltf::Model& model, const std::string& path) {
+    for (const std::string& extension : model.extensionsRequired) {
+        if (kSupportedRequiredExtensions.count(extension)) continue;
+        std::string supported;
+        for (const std::string& e : kSupportedRequiredExtensions) supported += (supported.empty() ? "" : ", ") + e;
+        fail(path, "the file requires the glTF extension '" + extension +
+                       "', which this loader does not support (it supports " + supported + ")");
+    }
+}
+
 // tinygltf's FileExists callback, for regular files only: a buffer whose uri named a directory
 // was opened and its "size" allocated (std::bad_alloc).
 bool regular_file_exists(const std::string& path, void*) {
@@ -871,6 +1103,9 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
     } catch (const std::exception& e) {  // e.g. a JSON parser exception
         fail(path, std::string("cannot parse glTF: ") + e.what());
     }
+    // tinygltf reads extensionsRequired before the buffers and accessors, so the list is there even
+    // when the load failed on what an unsupported extension changes: that is the error to report.
+    check_required_extensions(model, path);
     if (!ok) fail(path, "cannot read glTF: " + trim(err.empty() ? warn : err));
 
     GltfLoader g(model, path, embedded);
@@ -903,7 +1138,8 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
     for (int r : roots) g.add_node(r, glm::dmat4(1.0), 0);
     if (g.skipped_primitives)
         g.scene.warnings.push_back(path + ": skipped " + std::to_string(g.skipped_primitives) +
-                                   " primitive(s) whose mode is not TRIANGLES");
+                                   " primitive(s) of mode POINTS or LINES, or of an unknown mode (only triangles "
+                                   "are drawn)");
     return std::move(g.scene);
 }
 

@@ -72,13 +72,20 @@ struct LoadedScene {
 ///    OBJ has no cameras.
 ///  - `.gltf` (JSON with external or data-URI buffers and images) and `.glb` (binary, images in
 ///    bufferViews too): the default scene (else scene 0, else every root node); every node's
-///    mesh primitives of mode TRIANGLES (others are skipped with a warning) with any index
-///    component type, POSITION, COLOR_0 (vec3/vec4; float or normalized unsigned byte/short, all
-///    linear; vec4 is premultiplied), TEXCOORD_0 (vec2; float or normalized unsigned byte/short)
-///    as uvs and NORMAL (vec3; float or normalized byte/short) as normals, drawn with the node's
-///    world matrix (matrix or TRS, composed down the hierarchy); material baseColorFactor as the
-///    draw colour (linear RGBA; alphaMode BLEND blends "over" with the colour premultiplied by its
-///    alpha, other modes are opaque: alpha 1); doubleSided false culls back faces. The material's
+///    mesh primitives of mode TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN (strips and fans become
+///    triangles in the glTF spec's order, which keeps their winding for culling; fewer than 3
+///    vertices give none and a warning; points and lines are skipped with a warning), indexed
+///    with any index component type or not, from dense or sparse accessors (sparse: the base
+///    values from its bufferView, or zeros without one, with sparse.values written over the
+///    elements sparse.indices names), POSITION, COLOR_0 (vec3/vec4; float or normalized
+///    unsigned byte/short, all linear; vec4 is premultiplied), the texture coordinates the
+///    material's baseColorTexture reads (TEXCOORD_<texCoord>; TEXCOORD_0 for other materials;
+///    vec2, float or normalized unsigned byte/short; in files that use KHR_mesh_quantization
+///    also byte/short, normalized or not, and unnormalized unsigned byte/short) as uvs and NORMAL (vec3; float or
+///    normalized byte/short) as normals, drawn with the node's world matrix (matrix or TRS,
+///    composed down the hierarchy); material baseColorFactor as the draw colour (linear RGBA;
+///    alphaMode BLEND blends "over" with the colour premultiplied by its alpha, other modes are
+///    opaque: alpha 1); doubleSided false culls back faces. The material's
 ///    pbrMetallicRoughness.baseColorTexture becomes draw.texture: its image decoded from sRGB
 ///    into linear premultiplied RGBA (external files relative to the .gltf, percent-decoded;
 ///    data URIs and bufferViews from memory), its alpha ignored unless the material blends; the
@@ -89,10 +96,12 @@ struct LoadedScene {
 ///    9987 LINEAR_MIPMAP_LINEAR → (min_filter, mip_filter) = (nearest, nearest), (linear,
 ///    nearest), (nearest, linear), (linear, linear); undefined filters keep the library default
 ///    (trilinear), the footprint is isotropic, and values that are no glTF enum are warned about
-///    and replaced by the defaults. A baseColorTexture on another texCoord than 0, on a primitive
-///    without TEXCOORD_0, or whose texture has no source image is skipped with a warning (the
-///    draw is untextured); KHR_texture_transform is ignored with a warning. Cameras attached to
-///    nodes become NamedCameras in node order.
+///    and replaced by the defaults. A baseColorTexture on a primitive without the TEXCOORD_n it
+///    reads, or whose texture has no source image is skipped with a warning (the draw is
+///    untextured). The texture's KHR_texture_transform is applied to the mesh's uvs as they are
+///    read: uv' = T(offset)·R(rotation)·S(scale)·uv with R = [[cos, sin], [−sin, cos]] (row by
+///    row, as Khronos' sample models use it), and its texCoord overrides the texture's. Cameras
+///    attached to nodes become NamedCameras in node order.
 /// A texture file that is missing, unreadable or corrupt does not stop the load: the draw gets
 /// error_texture() (an 8×8 magenta/black checker) and a warning naming the material and the
 /// file. Images are shared through the texture cache (load_texture), so loading the same files
@@ -101,8 +110,14 @@ struct LoadedScene {
 /// extension, and std::runtime_error (or std::invalid_argument from Mesh::validate) whose
 /// message names the file and the problem for a missing, truncated or corrupt file, an
 /// accessor outside its buffer or of the wrong type or count (e.g. TEXCOORD_0 that is not VEC2),
-/// an index out of range (vertex, texture coordinate, normal, material, texture, sampler,
-/// image source), an image bufferView outside its buffer, a node cycle or absurd counts.
+/// a sparse accessor whose indices are out of range, not strictly increasing or of a type other
+/// than unsigned byte/short/int, whose index or value views lie outside their buffers, or whose
+/// sparse count exceeds its count, an extensionsRequired entry other than KHR_materials_unlit,
+/// KHR_mesh_quantization and KHR_texture_transform (e.g. Draco or meshopt compression),
+/// KHR_texture_transform values of the wrong type or length
+/// (naming the material), an index out of range (vertex, texture coordinate, normal,
+/// material, texture, sampler, image source), an image bufferView outside its buffer, a node
+/// cycle or absurd counts.
 LoadedScene load_scene(const std::string& path);
 
 /// World-space axis-aligned bounds of the draws' vertices (model matrices applied). Returns
