@@ -143,7 +143,8 @@ def test_missing_materials_warn_with_their_line_and_draw_white(tmp_path):
     path.write_text("mtllib m.mtl gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl blue\nf 1 2 3\n")
     scene, messages = load_quiet(path)
     assert scene.draws[0].color == (1, 1, 1, 1)
-    assert f"{path}: line 1: MTL file 'gone.mtl' not found next to the OBJ file; its materials are drawn white" in messages
+    missing = f"{path}: line 1: MTL file 'gone.mtl' not found next to the OBJ file; its materials are drawn white"
+    assert missing in messages
     assert f"{path}: line 5: usemtl 'blue' names no material of its MTL files; drawn white" in messages
 
 
@@ -189,6 +190,20 @@ def test_dissolve_blends_over_like_gltf_blend(tmp_path, statements, alpha, note)
         assert messages == []
     else:
         assert len(messages) == 1 and "material 'glass'" in messages[0] and note in messages[0], messages
+
+
+@pytest.mark.parametrize("dissolve", [1.0, 0.5])
+def test_map_kd_alpha_counts_only_when_the_material_blends(tmp_path, dissolve):
+    # As glTF: an opaque material ignores its texture's alpha, a blended one multiplies it in.
+    texels = TEXELS.copy()
+    texels[0, 1] = [0, 0.2, 0, 0.2]  # premultiplied: green at alpha 0.2
+    mr.write_image(tmp_path / "cutout.png", texels)
+    (tmp_path / "m.mtl").write_text(f"newmtl tex\nd {dissolve}\nmap_Kd cutout.png\n")
+    (tmp_path / "s.obj").write_text(obj_text())
+    scene, _ = mr.load_scene(tmp_path / "s.obj")
+    alpha = scene.draws[0].texture.level(0)[..., 3]
+    np.testing.assert_allclose(alpha, texels[..., 3] if dissolve < 1 else 1.0, atol=1e-6)
+    np.testing.assert_allclose(render(scene, 2)[0, 1, 3], 0.2 * dissolve if dissolve < 1 else 1.0, atol=1e-6)
 
 
 # --- text forms ------------------------------------------------------------------------------

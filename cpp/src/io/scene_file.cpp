@@ -243,7 +243,8 @@ ObjCorner parse_corner(std::string_view word, const std::size_t (&counts)[3], lo
         if (!parse_index(parts[k], i))
             bad("'" + std::string(parts[k]) + "' is not an index (an integer of at most " +
                 std::to_string(std::numeric_limits<int>::max()) + " in magnitude)");
-        if (i == 0) bad("index 0 in '" + std::string(word) + "' (OBJ indices count from 1, negative ones back from the last)");
+        if (i == 0)
+            bad("index 0 in '" + std::string(word) + "' (OBJ indices count from 1, negative ones back from the last)");
         if (i < 0 && static_cast<std::size_t>(-i) > counts[k])
             bad(std::string(kKinds[k]) + " index " + std::to_string(i) + " reaches before the first (" +
                 std::to_string(counts[k]) + " defined above)");
@@ -324,10 +325,12 @@ ObjSource read_obj_source(const std::string& path, std::vector<std::string>& war
     for (int k = 0; k < 3; ++k)
         if (largest[k] > static_cast<long long>(counts[k]))
             fail(path, "line " + std::to_string(largest_line[k]) + ": " + kKinds[k] + " index " +
-                           std::to_string(largest[k]) + " out of range (the file has " + std::to_string(counts[k]) + ")");
+                           std::to_string(largest[k]) + " out of range (the file has " +
+                           std::to_string(counts[k]) + ")");
     if (short_faces > 0)
-        warnings.push_back(path + ": " + std::to_string(short_faces) + " face(s) with fewer than 3 corners skipped (line " +
-                           std::to_string(first_short) + " is the first)");
+        warnings.push_back(path + ": " + std::to_string(short_faces) +
+                           " face(s) with fewer than 3 corners skipped (line " + std::to_string(first_short) +
+                           " is the first)");
     if (not_drawn > 0)
         warnings.push_back(path + ": " + std::to_string(not_drawn) + " line (l) or point (p) element(s) not drawn");
     return src;
@@ -390,8 +393,8 @@ std::string find_file(const std::string& dir, const std::string& relative) {
 /// or a folder that is not there, its file name alone. Returns the file found (empty if none).
 std::string locate(std::string written, const std::vector<std::string>& dirs) {
     std::replace(written.begin(), written.end(), '\\', '/');
-    const bool drive = written.size() > 2 && std::isalpha(static_cast<unsigned char>(written[0])) && written[1] == ':' &&
-                       written[2] == '/';
+    const bool drive = written.size() > 2 && std::isalpha(static_cast<unsigned char>(written[0])) &&
+                       written[1] == ':' && written[2] == '/';
     const bool absolute = drive || (!written.empty() && written[0] == '/');
     std::error_code ec;
     if (!drive && absolute && std::filesystem::is_regular_file(written, ec)) return written;
@@ -482,12 +485,14 @@ void parse_map_kd(std::string_view rest, ObjMaterial& m, const std::function<voi
             warn("map_Kd option '" + std::string(option) + "' is unknown; ignored");
         } else if (option == "-s" || option == "-o") {
             glm::vec2& v = option == "-s" ? m.uv_scale : m.uv_offset;
-            for (std::size_t i = 0; i < numbers.size() && i < 2; ++i) v[static_cast<int>(i)] = static_cast<float>(numbers[i]);
+            for (std::size_t i = 0; i < numbers.size() && i < 2; ++i)
+                v[static_cast<int>(i)] = static_cast<float>(numbers[i]);
         } else if (option == "-clamp") {
             m.clamp = word == "on";
         } else if (option == "-colorspace") {
             m.linear = word == "linear";
-        } else if ((option == "-mm" && !numbers.empty() && (numbers[0] != 0.0 || (numbers.size() > 1 && numbers[1] != 1.0))) ||
+        } else if ((option == "-mm" && !numbers.empty() &&
+                    (numbers[0] != 0.0 || (numbers.size() > 1 && numbers[1] != 1.0))) ||
                    (option == "-t" && std::any_of(numbers.begin(), numbers.end(), [](double x) { return x != 0.0; })) ||
                    (option == "-cc" && word == "on")) {
             warn("map_Kd option " + std::string(option) + " is not supported; the texture is drawn without it");
@@ -540,8 +545,8 @@ void read_mtl(const std::string& path, std::vector<ObjMaterial>& materials, std:
             }
             const std::vector<double> v = numbers(3);
             if (v.size() == 2) bad("Kd takes 1 or 3 numbers");
-            m->kd = v.size() == 1 ? glm::vec3(static_cast<float>(v[0]))
-                                  : glm::vec3(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]));
+            m->kd = glm::vec3(static_cast<float>(v[0]));
+            if (v.size() == 3) m->kd = glm::vec3(glm::dvec3(v[0], v[1], v[2]));
         } else if (keyword == "d" || keyword == "Tr") {
             std::string_view probe = rest;
             if (keyword == "d" && next_word(probe) == "-halo") {
@@ -586,7 +591,8 @@ std::vector<ObjMaterial> read_materials(const std::string& obj_path, const ObjSo
             warnings.push_back(where + "d " + std::to_string(m.d) + " and Tr " + std::to_string(m.tr) +
                                " disagree (Tr is 1 − d); using d");
         if (m.dissolve() == 0.0)
-            warnings.push_back(where + "fully transparent (" + (m.has_d ? "d 0" : "Tr 1") + "); its faces are invisible");
+            warnings.push_back(where + "fully transparent (" + (m.has_d ? "d 0" : "Tr 1") +
+                               "); its faces are invisible");
         materials.push_back(std::move(m));
     }
     return materials;
@@ -659,9 +665,10 @@ std::vector<std::array<std::size_t, 3>> triangulate(const std::vector<glm::dvec3
 // --- the loader --------------------------------------------------------------------------------
 
 /// The texture of a material's map_Kd: the file relative to its MTL file's folder (as MTL files
-/// mean it), else the OBJ's (see locate), decoded as sRGB unless -colorspace linear, alpha
-/// ignored (d gives OBJ opacity); a file found elsewhere than written is used with a warning, and
-/// a missing or unreadable one becomes the error texture with a warning.
+/// mean it), else the OBJ's (see locate), decoded as sRGB unless -colorspace linear, its alpha
+/// used only when the material blends (d < 1), as glTF does for alphaMode BLEND; a file found
+/// elsewhere than written is used with a warning, and a missing or unreadable one becomes the
+/// error texture with a warning.
 Texture map_kd_texture(const std::string& obj_path, const ObjMaterial& m, std::vector<std::string>& warnings) {
     const std::string where = m.mtl_path + ": material '" + m.name + "': ";
     std::vector<std::string> dirs = {directory_of(m.mtl_path)};
@@ -676,7 +683,7 @@ Texture map_kd_texture(const std::string& obj_path, const ObjMaterial& m, std::v
         warnings.push_back(where + "map_Kd '" + m.map_kd + "' is not at '" + as_written + "'; using '" + file + "'");
     }
     TextureFileOptions options;
-    options.ignore_alpha = true;
+    options.ignore_alpha = m.dissolve() >= 1.0;
     options.srgb = !m.linear;
     try {
         return load_texture(file, options);
@@ -753,14 +760,15 @@ LoadedScene load_obj(const std::string& path) {
             if (const auto it = src.long_faces.find(face_ordinal); it != src.long_faces.end()) corners = it->second;
             bool face_uvs = true, face_normals = true;
             for (const ObjCorner& c : corners) {  // (read_obj_source checked them; a safety net)
-                if (c.v < 0 || static_cast<std::size_t>(c.v) >= vertex_count || c.t >= static_cast<long long>(uv_count) ||
-                    c.n >= static_cast<long long>(normal_count))
+                if (c.v < 0 || static_cast<std::size_t>(c.v) >= vertex_count ||
+                    c.t >= static_cast<long long>(uv_count) || c.n >= static_cast<long long>(normal_count))
                     fail(path, "shape '" + shapes[s].name + "' face " + std::to_string(f) + ": index out of range");
                 face_uvs &= c.t >= 0;
                 face_normals &= c.n >= 0;
             }
             int material = f < m.material_ids.size() ? m.material_ids[f] : -1;
-            material = material >= 0 && static_cast<std::size_t>(material) < material_of.size() ? material_of[material] : -1;
+            const bool known = material >= 0 && static_cast<std::size_t>(material) < material_of.size();
+            material = known ? material_of[material] : -1;
             const bool textured = is_textured(material) && face_uvs;
             auto it = group_of.find({material, textured});
             if (it == group_of.end()) {
@@ -780,7 +788,8 @@ LoadedScene load_obj(const std::string& path) {
                 polygon.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]);
             }
             bool fanned = false;
-            for (const auto& t : triangulate(polygon, fanned)) g.triangles.push_back({corners[t[0]], corners[t[1]], corners[t[2]]});
+            for (const auto& t : triangulate(polygon, fanned))
+                g.triangles.push_back({corners[t[0]], corners[t[1]], corners[t[2]]});
             fanned_faces += fanned;
         }
     }
@@ -824,8 +833,8 @@ LoadedScene load_obj(const std::string& path) {
                                                   attrib.colors[3 * v + 2], 1.0f);
                     if (keep_uvs) {
                         const std::size_t i = static_cast<std::size_t>(key.t);
-                        const glm::vec2 uv = glm::vec2(attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]) * uv_scale +
-                                             uv_offset;
+                        const glm::vec2 vt(attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]);
+                        const glm::vec2 uv = vt * uv_scale + uv_offset;
                         mesh->uvs.emplace_back(uv.x, 1.0f - uv.y);  // OBJ's v runs up the image, ours down
                     }
                     if (keep_normals) {
@@ -843,7 +852,7 @@ LoadedScene load_obj(const std::string& path) {
         draw.mesh = mesh.get();
         if (g.material >= 0) {
             // Kd, and the dissolve as glTF's alphaMode BLEND does it: "over" with the colour
-            // premultiplied by its alpha (the texture's alpha stays ignored: map_d is the OBJ mask).
+            // premultiplied by its alpha.
             const ObjMaterial& mat = materials[g.material];
             const float alpha = static_cast<float>(mat.dissolve());
             draw.color = glm::vec4(mat.kd, 1.0f);
@@ -854,7 +863,8 @@ LoadedScene load_obj(const std::string& path) {
         }
         if (g.textured) {
             auto it = textures.find(g.material);
-            if (it == textures.end()) it = textures.emplace(g.material, map_kd_texture(path, materials[g.material], scene.warnings)).first;
+            if (it == textures.end())
+                it = textures.emplace(g.material, map_kd_texture(path, materials[g.material], scene.warnings)).first;
             draw.texture = it->second;
             if (materials[g.material].clamp) draw.sampler.wrap_u = draw.sampler.wrap_v = WrapMode::clamp;
         }
