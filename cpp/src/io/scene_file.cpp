@@ -388,13 +388,17 @@ std::string find_file(const std::string& dir, const std::string& relative) {
     return fs::is_regular_file(at, ec) ? at.string() : std::string();
 }
 
+/// A Windows drive path ("C:/...", after '\' became '/'): never a file here.
+bool is_drive_path(const std::string& name) {
+    return name.size() > 2 && std::isalpha(static_cast<unsigned char>(name[0])) && name[1] == ':' && name[2] == '/';
+}
+
 /// A file named in an OBJ or MTL file ('\' read as '/'), looked up in `dirs` in order: the path as
 /// written (relative to each folder), else, for a path from another machine (C:\..., /home/...)
 /// or a folder that is not there, its file name alone. Returns the file found (empty if none).
 std::string locate(std::string written, const std::vector<std::string>& dirs) {
     std::replace(written.begin(), written.end(), '\\', '/');
-    const bool drive = written.size() > 2 && std::isalpha(static_cast<unsigned char>(written[0])) &&
-                       written[1] == ':' && written[2] == '/';
+    const bool drive = is_drive_path(written);
     const bool absolute = drive || (!written.empty() && written[0] == '/');
     std::error_code ec;
     if (!drive && absolute && std::filesystem::is_regular_file(written, ec)) return written;
@@ -676,7 +680,7 @@ Texture map_kd_texture(const std::string& obj_path, const ObjMaterial& m, std::v
     std::string file = locate(m.map_kd, dirs);
     std::string as_written = m.map_kd;
     std::replace(as_written.begin(), as_written.end(), '\\', '/');
-    if (as_written.empty() || as_written[0] != '/') as_written = dirs[0] + as_written;
+    if (!is_drive_path(as_written) && (as_written.empty() || as_written[0] != '/')) as_written = dirs[0] + as_written;
     if (file.empty()) {
         file = as_written;
     } else if (std::filesystem::path(file).lexically_normal() != std::filesystem::path(as_written).lexically_normal()) {
