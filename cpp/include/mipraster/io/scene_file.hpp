@@ -57,19 +57,27 @@ struct LoadedScene {
 };
 
 /// Loads a scene file, choosing the reader by extension (case-insensitive):
-///  - `.obj` (+ its `mtllib` MTL files, looked up next to the OBJ): positions, faces (polygons
-///    are triangulated), vertex colours of the `v x y z r g b` extension (linear; used only when
-///    every vertex has one), texture coordinates (`vt`, with v flipped: v' = 1 − v, DESIGN.md §1)
-///    and normals (`vn`), and one draw per material with color = Kd taken as linear RGB (faces
-///    without a material: white). Vertices are split by their (position, vt, vn) index triple,
-///    so each mesh is compact and a position with two texture coordinates becomes two vertices;
-///    a mesh has uvs (normals) only when every face of its draw gives them. A material with
-///    `map_Kd` (the file relative to the OBJ's folder, `\` read as `/`) textures its faces with
-///    texture coordinates: draw.texture decoded as sRGB (`-colorspace linear`: linear), alpha
-///    ignored (OBJ draws are opaque), with the default sampler (trilinear, repeat; `-clamp on`:
-///    clamp); its `-s` scale and `-o` offset are applied to the uvs (uv·s + o, before the flip).
+///  - `.obj` (+ its `mtllib` MTL files, looked up next to the OBJ; every file of the line, names
+///    with spaces or `\`): positions, faces (polygons are triangulated: a quad along its shorter
+///    diagonal unless that one lies outside it, larger polygons by ear clipping), vertex colours
+///    of the `v x y z r g b` extension (linear; used only when every vertex has one), texture
+///    coordinates (`vt`, with v flipped: v' = 1 − v, DESIGN.md §1) and normals (`vn`), and one draw
+///    per material with color = Kd taken as linear RGB (white when the material gives no Kd or
+///    when faces have no material or an undefined one, with a warning). A material with d < 1
+///    (else Tr > 0: d = 1 − Tr) blends "over" with the colour premultiplied by d, as glTF BLEND.
+///    Vertices are split by their (position, vt, vn) index triple, so each mesh is compact and a
+///    position with two texture coordinates becomes two vertices; a mesh has uvs (normals) only
+///    when every face of its draw gives them. A material with `map_Kd` textures its faces with
+///    texture coordinates: the file relative to the MTL file's folder, else the OBJ's (`\` read as
+///    `/`; a path that is not there, such as another machine's absolute path, falls back to its
+///    file name there, and letter case is ignored when needed, with a warning), decoded as sRGB
+///    (`-colorspace linear`: linear), its alpha used only when d < 1, with the default sampler
+///    (trilinear, repeat; `-clamp on`: clamp); its `-s` scale and `-o` offset are applied to the
+///    uvs (uv·s + o, before the flip); `-mm`, `-t` and `-cc on` are warned about and not applied,
+///    other options skipped.
 ///    Its faces without texture coordinates become a separate untextured draw, with a warning.
-///    OBJ has no cameras.
+///    The text may have a byte order mark, CRLF or CR line ends, `\` continuations and comments
+///    after statements; l and p elements are skipped with a warning. OBJ has no cameras.
 ///  - `.gltf` (JSON with external or data-URI buffers and images) and `.glb` (binary, images in
 ///    bufferViews too): the default scene (else scene 0, else every root node); every node's
 ///    mesh primitives of mode TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN (strips and fans become
