@@ -1,0 +1,878 @@
+// glTF 2.0 files (.gltf with .bin or data-URI buffers, .glb) through tinygltf: accessors (dense
+// and sparse) read with bounds checks, node transforms, materials, samplers and cameras. The only
+// file that includes tinygltf.
+#include "scene_file_readers.hpp"
+
+#include "mipraster/core/memory_limit.hpp"
+#include "mipraster/io/texture_file.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
+
+#include <tiny_gltf.h>
+
+namespace mipraster {
+namespace scene_files {
+
+namespace {
+
+/// The node hierarchy is walked at most this deep (a deeper one is a cycle or hostile).
+constexpr int kMaxNodeDepth = 1024;
+static_assert(kMaxNodeDepth > 0, "limits must be positive");
+
+/// The encoded bytes of data-URI images, by image index, kept by keep_data_uri_image.
+struct EmbeddedImages {
+    std::map<int, std::vector<unsigned char>> bytes;
+};
+
+// tinygltf's image callback: decode nothing (textures are decoded by the io module's
+// load_texture through OpenImageIO). Only data-URI images are kept, as encoded bytes: external
+// files are read again relative to the glTF file by load_texture (which shares them), and
+// bufferView images are read from their buffer, with bounds checks, by the loader (tinygltf
+// passes a pointer it has not checked, so it is not touched here).
+bool keep_data_uri_image(tinygltf::Image* image, const int index, std::string*, std::string*, int, int,
+                         const unsigned char* bytes, int size, void* user) {
+    if (image->uri.empty() && image->bufferView < 0 && bytes != nullptr && size > 0)
+        static_cast<EmbeddedImages*>(user)->bytes[index].assign(bytes, bytes + size);
+    return true;
+}
+
+/// A URI reference with its %XX escapes decoded (glTF URIs are percent-encoded); an invalid
+/// escape is kept as it is.
+std::string percent_decode(const std::string& uri) {
+    auto hex = [](char c) {
+        if (c >= '0' && c <= '9') return c - '0';
+        if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+        if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+        return -1;
+    };
+    std::string out;
+    for (std::size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && hex(uri[i + 1]) >= 0 && hex(uri[i + 2]) >= 0) {
+            out += static_cast<char>(hex(uri[i + 1]) * 16 + hex(uri[i + 2]));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
+}
+
+/// Reads an accessor's elements as doubles (normalized integers mapped to [0, 1] / [−1, 1]),
+/// after checking that every byte it names lies inside its buffer. A sparse accessor is
+/// materialized first into an owned, tightly packed copy, which is then read like a dense one.
+class AccessorReader {
+public:
+    AccessorReader(const tinygltf::Model& model, int index, const std::string& path, const std::string& what)
+        : path_(path), what_(what) {
+        if (index < 0 || static_cast<std::size_t>(index) >= model.accessors.size())
+            fail(path, what + ": accessor " + std::to_string(index) + " does not exist (the file has " +
+                           std::to_string(model.accessors.size()) + ")");
+        const tinygltf::Accessor& a = model.accessors[index];
+        what_ = what + " (accessor " + std::to_string(index) + (a.name.empty() ? "" : " '" + a.name + "'") + ")";
+        count_ = a.count;
+        components_ = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
+        component_type_ = a.componentType;
+        size_ = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(a.componentType));
+        normalized_ = a.normalized;
+        if (components_ <= 0 || components_ > 4 || size_ <= 0)
+            fail(path, what_ + ": unsupported type " + std::to_string(a.type) + " / component type " +
+                           std::to_string(a.componentType));
+        if (count_ > kMaxElements) fail(path, what_ + ": absurd count " + std::to_string(count_));
+        if (a.sparse.isSparse) {
+            materialize_sparse(model, a);
+        } else if (count_ > 0) {
+            read_dense(model, a);
+        }
+    }
+    // data_ may point into owned_: a copy would point into the original's.
+    AccessorReader(const AccessorReader&) = delete;
+    AccessorReader& operator=(const AccessorReader&) = delete;
+
+    std::size_t count() const { return count_; }
+    int components() const { return components_; }
+    int component_type() const { return component_type_; }
+    bool normalized() const { return normalized_; }
+    const std::string& what() const { return what_; }
+
+    double get(std::size_t i, int c) const {
+        const unsigned char* p = data_ + i * stride_ + static_cast<std::size_t>(c) * size_;
+        switch (component_type_) {
+            case TINYGLTF_COMPONENT_TYPE_FLOAT: return load<float>(p);
+            case TINYGLTF_COMPONENT_TYPE_DOUBLE: return load<double>(p);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return scaled(load<std::uint8_t>(p), 255.0);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return scaled(load<std::uint16_t>(p), 65535.0);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return static_cast<double>(load<std::uint32_t>(p));
+            case TINYGLTF_COMPONENT_TYPE_BYTE: return signed_scaled(load<std::int8_t>(p), 127.0);
+            case TINYGLTF_COMPONENT_TYPE_SHORT: return signed_scaled(load<std::int16_t>(p), 32767.0);
+            case TINYGLTF_COMPONENT_TYPE_INT: return static_cast<double>(load<std::int32_t>(p));
+            default: fail(path_, what_ + ": unsupported component type " + std::to_string(component_type_));
+        }
+    }
+
+    /// An unsigned integer element (indices), unscaled.
+    std::uint64_t get_index(std::size_t i) const {
+        const unsigned char* p = data_ + i * stride_;
+        switch (component_type_) {
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return load<std::uint8_t>(p);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return load<std::uint16_t>(p);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return load<std::uint32_t>(p);
+            default:
+                fail(path_, what_ + ": indices must be unsigned byte, short or int, got component type " +
+                                std::to_string(component_type_));
+        }
+    }
+
+private:
+    template <class T>
+    static T load(const unsigned char* p) {
+        T v;
+        std::memcpy(&v, p, sizeof v);
+        return v;
+    }
+    double scaled(double v, double max) const { return normalized_ ? v / max : v; }
+    double signed_scaled(double v, double max) const { return normalized_ ? std::max(v / max, -1.0) : v; }
+
+    std::size_t element_size() const { return static_cast<std::size_t>(components_) * static_cast<std::size_t>(size_); }
+
+    /// Buffer view `index`, after checking that it and its buffer exist and that it lies inside the
+    /// buffer; `part` ("" or "sparse indices: " / "sparse values: ") says which part of the accessor
+    /// uses it.
+    const tinygltf::BufferView& checked_view(const tinygltf::Model& model, int index, const std::string& part) const {
+        if (index < 0 || static_cast<std::size_t>(index) >= model.bufferViews.size())
+            fail(path_, what_ + ": " + part + "buffer view " + std::to_string(index) + " does not exist");
+        const tinygltf::BufferView& view = model.bufferViews[index];
+        if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size())
+            fail(path_, what_ + ": " + part + "buffer " + std::to_string(view.buffer) + " does not exist");
+        const std::size_t buffer_size = model.buffers[view.buffer].data.size();
+        if (view.byteOffset > buffer_size || view.byteLength > buffer_size - view.byteOffset)
+            fail(path_, what_ + ": " + part + "buffer view " + std::to_string(index) + " (offset " +
+                            std::to_string(view.byteOffset) + ", length " + std::to_string(view.byteLength) +
+                            ") lies outside its buffer of " + std::to_string(buffer_size) + " bytes");
+        return view;
+    }
+
+    /// The bytes [offset, offset + needed) of buffer view `index`, which hold `elements` elements,
+    /// after checking that they lie inside the view (and the view inside its buffer).
+    const unsigned char* view_range(const tinygltf::Model& model, int index, std::size_t offset, std::size_t needed,
+                                    std::size_t elements, const std::string& part) const {
+        const tinygltf::BufferView& view = checked_view(model, index, part);
+        if (offset > view.byteLength || needed > view.byteLength - offset)
+            fail(path_, what_ + ": " + part + std::to_string(elements) + " elements need " + std::to_string(needed) +
+                            " bytes from byte offset " + std::to_string(offset) + ", buffer view " +
+                            std::to_string(index) + " has " + std::to_string(view.byteLength));
+        return model.buffers[view.buffer].data.data() + view.byteOffset + offset;
+    }
+
+    /// Points data_ at the accessor's count_ (> 0) elements in its buffer view, stride_ apart.
+    void read_dense(const tinygltf::Model& model, const tinygltf::Accessor& a) {
+        const tinygltf::BufferView& view = checked_view(model, a.bufferView, "");
+        const std::size_t element = element_size();
+        stride_ = view.byteStride ? view.byteStride : element;
+        if (stride_ < element || stride_ > 252 + element)
+            fail(path_, what_ + ": byte stride " + std::to_string(view.byteStride) + " is invalid");
+        // count ≤ 2^32 and stride ≤ 256: the product does not overflow.
+        data_ = view_range(model, a.bufferView, a.byteOffset, (count_ - 1) * stride_ + element, count_, "");
+    }
+
+    /// A sparse accessor (glTF 2.0 §3.6.2.3) copied into owned_, tightly packed: the base values
+    /// from its buffer view (zeros when it has none), then element sparse.indices[k] replaced by
+    /// sparse.values[k]. The indices must be unsigned byte/short/int, strictly increasing and below
+    /// count; both arrays are tightly packed in their views.
+    void materialize_sparse(const tinygltf::Model& model, const tinygltf::Accessor& a) {
+        const auto& sparse = a.sparse;
+        if (sparse.count < 1)
+            fail(path_, what_ + ": sparse count " + std::to_string(sparse.count) + " must be at least 1");
+        const std::size_t n = static_cast<std::size_t>(sparse.count);
+        if (n > count_)
+            fail(path_, what_ + ": sparse count " + std::to_string(n) + " is larger than the accessor's count " +
+                            std::to_string(count_));
+        const int index_type = sparse.indices.componentType;
+        if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            fail(path_, what_ + ": sparse indices must be unsigned byte, short or int, got component type " +
+                            std::to_string(index_type));
+        if (sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0)
+            fail(path_, what_ + ": sparse byte offsets must not be negative");
+
+        const std::size_t element = element_size();
+        // Without a base view, a few bytes of JSON can ask for count × element bytes of zeros.
+        check_memory(static_cast<std::uint64_t>(count_) * element, path_ + ": " + what_ + " (a sparse accessor)");
+        owned_.assign(count_ * element, 0);
+        if (a.bufferView >= 0) {
+            read_dense(model, a);
+            for (std::size_t i = 0; i < count_; ++i) std::memcpy(&owned_[i * element], data_ + i * stride_, element);
+        }
+        const std::size_t index_size = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(index_type));
+        const unsigned char* indices = view_range(model, sparse.indices.bufferView, sparse.indices.byteOffset,
+                                                  n * index_size, n, "sparse indices: ");
+        const unsigned char* values = view_range(model, sparse.values.bufferView, sparse.values.byteOffset,
+                                                 n * element, n, "sparse values: ");
+        for (std::size_t k = 0; k < n; ++k) {
+            const std::uint64_t i = unsigned_at(indices + k * index_size, index_type);
+            if (i >= count_)
+                fail(path_, what_ + ": sparse index " + std::to_string(i) + " (element " + std::to_string(k) +
+                                ") is out of range (the accessor's count is " + std::to_string(count_) + ")");
+            if (k > 0 && i <= unsigned_at(indices + (k - 1) * index_size, index_type))
+                fail(path_, what_ + ": sparse indices are not strictly increasing: " +
+                                std::to_string(unsigned_at(indices + (k - 1) * index_size, index_type)) +
+                                " is followed by " + std::to_string(i) + " (element " + std::to_string(k) + ")");
+            std::memcpy(&owned_[i * element], values + k * element, element);
+        }
+        data_ = owned_.data();
+        stride_ = element;
+    }
+
+    /// The unsigned integer of component type `type` (unsigned byte, short or int) at p.
+    static std::uint64_t unsigned_at(const unsigned char* p, int type) {
+        switch (type) {
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return load<std::uint8_t>(p);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return load<std::uint16_t>(p);
+            default: return load<std::uint32_t>(p);
+        }
+    }
+
+    std::string path_, what_;
+    std::vector<unsigned char> owned_;  // a sparse accessor's materialized elements
+    const unsigned char* data_ = nullptr;
+    std::size_t count_ = 0, stride_ = 0;
+    int components_ = 0, component_type_ = 0, size_ = 0;
+    bool normalized_ = false;
+};
+
+glm::dmat4 node_matrix(const tinygltf::Node& node, const std::string& path, int index) {
+    const std::string what = "node " + std::to_string(index) + " ('" + node.name + "')";
+    if (!node.matrix.empty()) {
+        if (node.matrix.size() != 16) fail(path, what + ": matrix must have 16 numbers");
+        glm::dmat4 m;
+        for (int i = 0; i < 16; ++i) m[i / 4][i % 4] = node.matrix[i];  // column-major, as glTF stores it
+        return m;
+    }
+    glm::dmat4 t(1.0), r(1.0), s(1.0);
+    if (!node.translation.empty()) {
+        if (node.translation.size() != 3) fail(path, what + ": translation must have 3 numbers");
+        t[3] = glm::dvec4(node.translation[0], node.translation[1], node.translation[2], 1.0);
+    }
+    if (!node.rotation.empty()) {
+        if (node.rotation.size() != 4) fail(path, what + ": rotation must have 4 numbers");
+        glm::dquat q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);  // (w, x, y, z)
+        const double len = glm::length(q);
+        if (!(len > 0.0) || !std::isfinite(len)) fail(path, what + ": rotation is not a valid quaternion");
+        r = glm::mat4_cast(q / len);
+    }
+    if (!node.scale.empty()) {
+        if (node.scale.size() != 3) fail(path, what + ": scale must have 3 numbers");
+        s[0][0] = node.scale[0];
+        s[1][1] = node.scale[1];
+        s[2][2] = node.scale[2];
+    }
+    return t * r * s;
+}
+
+/// Whether a primitive mode is one of triangles (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN; −1: not
+/// given, TRIANGLES) rather than POINTS, LINES, LINE_LOOP, LINE_STRIP or a value glTF does not define.
+bool draws_triangles(int mode) {
+    return mode == -1 || mode == TINYGLTF_MODE_TRIANGLES || mode == TINYGLTF_MODE_TRIANGLE_STRIP ||
+           mode == TINYGLTF_MODE_TRIANGLE_FAN;
+}
+
+/// Which texture coordinate set (TEXCOORD_<set>) becomes a primitive's uvs, and the affine map
+/// that KHR_texture_transform applies to it: uv' = T(offset)·R(rotation)·S(scale)·uv.
+struct UvChoice {
+    int set = 0;
+    bool transformed = false;  // (the identity is skipped: it would turn an infinite v into NaN u)
+    glm::dvec2 offset{0.0}, scale{1.0};
+    double rotation = 0.0;
+
+    /// The transformed uv. R is [[cos, sin], [−sin, cos]] (row by row), the rotation Khronos'
+    /// sample models, Blender and three.js use: the extension's GLSL listing fills a column-major
+    /// mat3 with the same numbers, which reads as the transpose (KhronosGroup/glTF issue #1563);
+    /// its example (offset (0, 1), rotation π/2, scale ½ selects the lower-left quadrant) agrees
+    /// with this form only.
+    glm::vec2 apply(glm::dvec2 uv) const {
+        const double c = std::cos(rotation), s = std::sin(rotation);
+        const glm::dvec2 scaled = uv * scale;
+        return glm::vec2(c * scaled.x + s * scaled.y + offset.x, -s * scaled.x + c * scaled.y + offset.y);
+    }
+};
+
+struct GltfLoader {
+    const tinygltf::Model& model;
+    const std::string& path;
+    const EmbeddedImages& embedded;
+    LoadedScene scene;
+    std::map<std::pair<int, int>, std::shared_ptr<Mesh>> mesh_cache;  // (mesh, primitive) → mesh
+    std::map<std::pair<int, bool>, Texture> texture_cache;            // (image, ignore alpha) → texture
+    std::set<std::string> warned;                                     // warnings given once
+    std::size_t skipped_primitives = 0;
+    std::vector<bool> on_path;  // nodes on the current root-to-node path (cycle detection)
+    bool quantized = false;     // the file uses KHR_mesh_quantization (integer texture coordinates)
+
+    GltfLoader(const tinygltf::Model& m, const std::string& p, const EmbeddedImages& e)
+        : model(m), path(p), embedded(e), on_path(m.nodes.size(), false) {
+        const auto lists = [&](const std::vector<std::string>& names) {
+            return std::find(names.begin(), names.end(), "KHR_mesh_quantization") != names.end();
+        };
+        quantized = lists(m.extensionsUsed) || lists(m.extensionsRequired);
+    }
+
+    void warn_once(const std::string& message) {
+        if (warned.insert(message).second) scene.warnings.push_back(path + ": " + message);
+    }
+
+    static std::string material_name(const tinygltf::Material& mat, int index) {
+        const std::string where = "materials[" + std::to_string(index) + "]";
+        return mat.name.empty() ? "material " + where : "material '" + mat.name + "' (" + where + ")";
+    }
+
+    /// The draw's colour, blending, culling, base colour texture and sampler from its material.
+    void apply_material(Draw& draw, const tinygltf::Primitive& prim, int mesh_index, int prim_index) {
+        const std::string prim_what =
+            "meshes[" + std::to_string(mesh_index) + "].primitives[" + std::to_string(prim_index) + "]";
+        if (prim.material < 0) {
+            draw.state.cull = CullMode::back;  // the default material is single-sided
+            return;
+        }
+        if (static_cast<std::size_t>(prim.material) >= model.materials.size())
+            fail(path, prim_what + ": material " + std::to_string(prim.material) + " does not exist (the file has " +
+                           std::to_string(model.materials.size()) + ")");
+        const tinygltf::Material& mat = model.materials[prim.material];
+        const std::string name = material_name(mat, prim.material);
+        const std::vector<double>& f = mat.pbrMetallicRoughness.baseColorFactor;
+        if (f.size() != 4) fail(path, name + ": baseColorFactor must have 4 numbers");
+        for (double v : f)
+            if (!std::isfinite(v)) fail(path, name + ": baseColorFactor is not finite");
+        const bool blend = mat.alphaMode == "BLEND";
+        if (blend) {
+            draw.color = glm::vec4(f[0] * f[3], f[1] * f[3], f[2] * f[3], f[3]);
+            draw.state.blend = BlendMode::over;
+        } else {
+            draw.color = glm::vec4(f[0], f[1], f[2], 1.0);
+        }
+        if (!mat.doubleSided) draw.state.cull = CullMode::back;
+
+        // Base colour texture, on the uvs base_color_uvs chose (and transformed) for the mesh.
+        const tinygltf::TextureInfo& info = mat.pbrMetallicRoughness.baseColorTexture;
+        if (info.index < 0) return;
+        if (static_cast<std::size_t>(info.index) >= model.textures.size())
+            fail(path, name + ": baseColorTexture index " + std::to_string(info.index) +
+                           " does not exist (the file has " + std::to_string(model.textures.size()) + " textures)");
+        const tinygltf::Texture& tex = model.textures[info.index];
+        const std::string tex_what = "textures[" + std::to_string(info.index) + "]";
+        Sampler sampler = sampler_of(tex.sampler, tex_what);  // checks the index even when unused below
+        if (tex.source >= 0 && static_cast<std::size_t>(tex.source) >= model.images.size())
+            fail(path, tex_what + ": source image " + std::to_string(tex.source) + " does not exist (the file has " +
+                           std::to_string(model.images.size()) + " images)");
+        if (!draw.mesh->has_uvs()) {
+            warn_once(prim_what + " has no TEXCOORD_" + std::to_string(base_color_uvs(prim.material).set) +
+                      " but its " + name +
+                      " has a baseColorTexture; drawn without the texture");
+            return;
+        }
+        if (tex.source < 0) {
+            warn_once(tex_what + " (used by " + name +
+                      ") has no source image (only extension images such as KTX2/WebP?); drawn without it");
+            return;
+        }
+        draw.texture = image_texture(tex.source, name, /*ignore_alpha=*/!blend);
+        draw.sampler = sampler;
+    }
+
+    /// glTF sampler → Sampler. Undefined filters keep the library default (trilinear); undefined
+    /// wraps are REPEAT. Unknown enum values are warned about and replaced by the defaults.
+    Sampler sampler_of(int index, const std::string& tex_what) {
+        Sampler s;
+        if (index < 0) return s;
+        if (static_cast<std::size_t>(index) >= model.samplers.size())
+            fail(path, tex_what + ": sampler " + std::to_string(index) + " does not exist (the file has " +
+                           std::to_string(model.samplers.size()) + " samplers)");
+        const tinygltf::Sampler& g = model.samplers[index];
+        const std::string what = "samplers[" + std::to_string(index) + "]";
+        auto wrap = [&](int mode, const char* field) {
+            switch (mode) {
+                case TINYGLTF_TEXTURE_WRAP_REPEAT: return WrapMode::repeat;
+                case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return WrapMode::clamp;
+                case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return WrapMode::mirror;
+                default:
+                    warn_once(what + ": " + field + " " + std::to_string(mode) + " is not a glTF wrap mode; using REPEAT");
+                    return WrapMode::repeat;
+            }
+        };
+        s.wrap_u = wrap(g.wrapS, "wrapS");
+        s.wrap_v = wrap(g.wrapT, "wrapT");
+        switch (g.magFilter) {
+            case -1: break;
+            case TINYGLTF_TEXTURE_FILTER_NEAREST: s.mag_filter = TexelFilter::nearest; break;
+            case TINYGLTF_TEXTURE_FILTER_LINEAR: s.mag_filter = TexelFilter::linear; break;
+            default:
+                warn_once(what + ": magFilter " + std::to_string(g.magFilter) + " is not a glTF filter; using LINEAR");
+        }
+        // minFilter = texel filter within a level + filter between levels.
+        switch (g.minFilter) {
+            case -1: break;
+            case TINYGLTF_TEXTURE_FILTER_NEAREST: s.min_filter = TexelFilter::nearest, s.mip_filter = MipFilter::none; break;
+            case TINYGLTF_TEXTURE_FILTER_LINEAR: s.min_filter = TexelFilter::linear, s.mip_filter = MipFilter::none; break;
+            case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST:
+                s.min_filter = TexelFilter::nearest, s.mip_filter = MipFilter::nearest;
+                break;
+            case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST:
+                s.min_filter = TexelFilter::linear, s.mip_filter = MipFilter::nearest;
+                break;
+            case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR:
+                s.min_filter = TexelFilter::nearest, s.mip_filter = MipFilter::linear;
+                break;
+            case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR:
+                s.min_filter = TexelFilter::linear, s.mip_filter = MipFilter::linear;
+                break;
+            default:
+                warn_once(what + ": minFilter " + std::to_string(g.minFilter) +
+                          " is not a glTF filter; using LINEAR_MIPMAP_LINEAR");
+        }
+        return s;
+    }
+
+    /// The texture of image `index` (sRGB colour; alpha ignored for opaque materials), decoded once
+    /// per load. An image that cannot be read gives the error texture and a warning naming the
+    /// material and the file; an image whose bufferView lies outside its buffer is an error.
+    Texture image_texture(int index, const std::string& material, bool ignore_alpha) {
+        const auto key = std::make_pair(index, ignore_alpha);
+        if (auto it = texture_cache.find(key); it != texture_cache.end()) return it->second;
+        const tinygltf::Image& image = model.images[index];
+        const std::string what = "images[" + std::to_string(index) + "]" + (image.name.empty() ? "" : " ('" + image.name + "')");
+        TextureFileOptions options;
+        options.srgb = true;  // glTF base colour textures are sRGB
+        options.ignore_alpha = ignore_alpha;
+        Texture texture;
+        std::string source;  // the file or the embedded image, for the warning
+        const unsigned char* view_bytes = nullptr;
+        std::size_t view_size = 0;
+        if (image.uri.empty() && image.bufferView >= 0)
+            buffer_view_bytes(image.bufferView, what, view_bytes, view_size);  // a bad view is an error, not a warning
+        try {
+            if (!image.uri.empty()) {
+                if (image.uri.rfind("data:", 0) == 0) {  // tinygltf decodes PNG, JPEG, BMP and GIF data URIs only
+                    source = what + " (data URI)";
+                    const std::string type = image.uri.substr(5, std::min<std::size_t>(image.uri.find_first_of(";,"), 64) - 5);
+                    throw std::runtime_error("data URI of media type '" + type + "' is not supported");
+                }
+                const std::string uri = percent_decode(image.uri);
+                source = "'" + uri + "'";
+                if (uri.find("://") != std::string::npos)
+                    throw std::runtime_error("only relative file URIs are supported");
+                source = "'" + directory_of(path) + uri + "'";
+                texture = load_texture(directory_of(path) + uri, options);
+            } else if (image.bufferView >= 0) {
+                source = what + " (bufferView " + std::to_string(image.bufferView) + ")";
+                texture = load_texture_from_memory(view_bytes, view_size, path + " " + what, options);
+            } else {
+                source = what + " (data URI)";
+                const auto it = embedded.bytes.find(index);
+                if (it == embedded.bytes.end()) throw std::runtime_error("the data URI holds no bytes");
+                texture = load_texture_from_memory(it->second.data(), it->second.size(), path + " " + what, options);
+            }
+        } catch (const std::exception& e) {  // missing, unreadable, corrupt or too large
+            warn_once(material + ": cannot load its base colour texture " + source + " (" + e.what() +
+                      "); drawing the error texture instead");
+            texture = error_texture();
+        }
+        texture_cache.emplace(key, texture);
+        return texture;
+    }
+
+    /// The bytes of a bufferView, after checking that they lie inside its buffer.
+    void buffer_view_bytes(int index, const std::string& what, const unsigned char*& bytes, std::size_t& size) const {
+        if (index < 0 || static_cast<std::size_t>(index) >= model.bufferViews.size())
+            fail(path, what + ": buffer view " + std::to_string(index) + " does not exist");
+        const tinygltf::BufferView& view = model.bufferViews[index];
+        if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size())
+            fail(path, what + ": buffer " + std::to_string(view.buffer) + " does not exist");
+        const std::vector<unsigned char>& buffer = model.buffers[view.buffer].data;
+        if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
+            fail(path, what + ": buffer view " + std::to_string(index) + " (offset " + std::to_string(view.byteOffset) +
+                           ", length " + std::to_string(view.byteLength) + ") lies outside its buffer of " +
+                           std::to_string(buffer.size()) + " bytes");
+        bytes = buffer.data() + view.byteOffset;
+        size = view.byteLength;
+    }
+
+    bool material_blends(int material) const {
+        return material >= 0 && static_cast<std::size_t>(material) < model.materials.size() &&
+               model.materials[material].alphaMode == "BLEND";
+    }
+
+    /// The primitive's vertices in drawing order: its indices (any unsigned component type, each
+    /// checked against the vertex count), or 0, 1, …, vertex_count − 1 when it has none.
+    std::vector<std::uint32_t> vertex_sequence(const tinygltf::Primitive& prim, std::size_t vertex_count,
+                                               const std::string& what) const {
+        std::vector<std::uint32_t> sequence;
+        if (prim.indices < 0) {
+            sequence.resize(vertex_count);
+            for (std::size_t i = 0; i < vertex_count; ++i) sequence[i] = static_cast<std::uint32_t>(i);
+            return sequence;
+        }
+        const AccessorReader idx(model, prim.indices, path, what + " indices");
+        if (idx.components() != 1) fail(path, idx.what() + ": indices must be SCALAR");
+        sequence.resize(idx.count());
+        for (std::size_t i = 0; i < idx.count(); ++i) {
+            const std::uint64_t v = idx.get_index(i);
+            if (v >= vertex_count)
+                fail(path, idx.what() + ": index " + std::to_string(v) + " (element " + std::to_string(i) +
+                               ") is out of range (" + std::to_string(vertex_count) + " vertices)");
+            sequence[i] = static_cast<std::uint32_t>(v);
+        }
+        return sequence;
+    }
+
+    /// The triangles of a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN vertex sequence v, in the order
+    /// of the glTF 2.0 spec (§3.7.2.1): strip triangle i is (v[i], v[i+1+i%2], v[i+2−i%2]), i.e. odd
+    /// triangles swap their last two vertices so that all keep the strip's winding (back-face
+    /// culling depends on it); fan triangle i is (v[i+1], v[i+2], v[0]). Leftover vertices (a
+    /// TRIANGLES count that is no multiple of 3) and strips or fans of fewer than 3 vertices give
+    /// a warning.
+    std::vector<glm::uvec3> assemble_triangles(int mode, const std::vector<std::uint32_t>& v,
+                                               const std::string& what) {
+        const std::size_t n = v.size();
+        std::vector<glm::uvec3> triangles;
+        if (mode == TINYGLTF_MODE_TRIANGLES || mode == -1) {
+            if (n % 3 != 0)
+                scene.warnings.push_back(path + ": " + what + ": vertex count " + std::to_string(n) +
+                                         " is not a multiple of 3; the last vertices are ignored");
+            triangles.resize(n / 3);
+            for (std::size_t t = 0; t < triangles.size(); ++t) triangles[t] = {v[3 * t], v[3 * t + 1], v[3 * t + 2]};
+            return triangles;
+        }
+        const bool strip = mode == TINYGLTF_MODE_TRIANGLE_STRIP;
+        if (n < 3) {
+            scene.warnings.push_back(path + ": " + what + ": a triangle " + (strip ? "strip" : "fan") + " of " +
+                                     std::to_string(n) + " vertices has no triangle");
+            return triangles;
+        }
+        triangles.resize(n - 2);
+        for (std::size_t i = 0; i < n - 2; ++i)
+            triangles[i] = strip ? glm::uvec3(v[i], v[i + 1 + i % 2], v[i + 2 - i % 2])
+                                 : glm::uvec3(v[i + 1], v[i + 2], v[0]);
+        return triangles;
+    }
+
+    /// The texture coordinate set the base colour texture of material `material` reads
+    /// (baseColorTexture.texCoord, or its KHR_texture_transform's texCoord) and that extension's
+    /// transform; set 0 and the identity for no material, an untextured one or one that does not
+    /// exist (apply_material reports that). Malformed transform values are an error naming the
+    /// material.
+    UvChoice base_color_uvs(int material) const {
+        UvChoice choice;
+        if (material < 0 || static_cast<std::size_t>(material) >= model.materials.size()) return choice;
+        const tinygltf::Material& mat = model.materials[material];
+        const tinygltf::TextureInfo& info = mat.pbrMetallicRoughness.baseColorTexture;
+        if (info.index < 0) return choice;
+        choice.set = info.texCoord;
+        const auto ext = info.extensions.find("KHR_texture_transform");
+        if (ext == info.extensions.end()) return choice;
+
+        choice.transformed = true;
+        const std::string what = material_name(mat, material) + ": KHR_texture_transform ";
+        const tinygltf::Value& t = ext->second;  // (an object: tinygltf drops extensions that are not)
+        const auto finite_number = [](const tinygltf::Value& v) {
+            return v.IsNumber() && std::isfinite(v.GetNumberAsDouble());
+        };
+        const auto pair = [&](const char* key, glm::dvec2 value) {
+            if (!t.Has(key)) return value;
+            const tinygltf::Value& v = t.Get(key);
+            if (!v.IsArray() || v.ArrayLen() != 2 || !finite_number(v.Get(0)) || !finite_number(v.Get(1)))
+                fail(path, what + key + " must be 2 finite numbers");
+            return glm::dvec2(v.Get(0).GetNumberAsDouble(), v.Get(1).GetNumberAsDouble());
+        };
+        choice.offset = pair("offset", choice.offset);
+        choice.scale = pair("scale", choice.scale);
+        if (t.Has("rotation")) {
+            if (!finite_number(t.Get("rotation"))) fail(path, what + "rotation must be a finite number");
+            choice.rotation = t.Get("rotation").GetNumberAsDouble();
+        }
+        if (t.Has("texCoord")) {  // overrides the textureInfo's
+            const tinygltf::Value& v = t.Get("texCoord");
+            if (!v.IsInt() || v.GetNumberAsInt() < 0) fail(path, what + "texCoord must be an integer >= 0");
+            choice.set = v.GetNumberAsInt();
+        }
+        return choice;
+    }
+
+    /// Whether a TEXCOORD_n component type is allowed: float or normalized unsigned byte/short
+    /// (glTF 2.0), and in files that use KHR_mesh_quantization also byte and short (normalized or
+    /// not) and unnormalized unsigned byte/short, read as their integer values.
+    bool texcoord_type_allowed(int type, bool normalized) const {
+        if (type == TINYGLTF_COMPONENT_TYPE_FLOAT) return true;
+        const bool small_unsigned =
+            type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+        if (small_unsigned && normalized) return true;
+        return quantized &&
+               (small_unsigned || type == TINYGLTF_COMPONENT_TYPE_BYTE || type == TINYGLTF_COMPONENT_TYPE_SHORT);
+    }
+
+    std::shared_ptr<Mesh> primitive_mesh(int mesh_index, int prim_index) {
+        const auto key = std::make_pair(mesh_index, prim_index);
+        if (auto it = mesh_cache.find(key); it != mesh_cache.end()) return it->second;
+        const tinygltf::Primitive& prim = model.meshes[mesh_index].primitives[prim_index];
+        const std::string what = "meshes[" + std::to_string(mesh_index) + "].primitives[" + std::to_string(prim_index) + "]";
+        auto mesh = std::make_shared<Mesh>();
+
+        // Positions.
+        const auto pos_it = prim.attributes.find("POSITION");
+        if (pos_it == prim.attributes.end()) fail(path, what + ": no POSITION attribute");
+        const AccessorReader pos(model, pos_it->second, path, what + " POSITION");
+        if (pos.components() != 3) fail(path, pos.what() + ": POSITION must be VEC3");
+        mesh->positions.resize(pos.count());
+        for (std::size_t i = 0; i < pos.count(); ++i)
+            mesh->positions[i] = glm::vec3(pos.get(i, 0), pos.get(i, 1), pos.get(i, 2));
+
+        // Vertex colours (linear); premultiplied by their alpha when the material blends,
+        // opaque otherwise (alpha is ignored for OPAQUE/MASK materials).
+        if (const auto col_it = prim.attributes.find("COLOR_0"); col_it != prim.attributes.end()) {
+            const AccessorReader col(model, col_it->second, path, what + " COLOR_0");
+            if (col.components() != 3 && col.components() != 4) fail(path, col.what() + ": COLOR_0 must be VEC3 or VEC4");
+            const int ct = col.component_type();
+            if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+                !((ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
+                  col.normalized()))
+                fail(path, col.what() + ": COLOR_0 must be float or normalized unsigned byte/short");
+            if (col.count() != pos.count())
+                fail(path, col.what() + ": COLOR_0 has " + std::to_string(col.count()) + " elements, POSITION " +
+                               std::to_string(pos.count()));
+            const bool blend = material_blends(prim.material);
+            mesh->colors.resize(col.count());
+            for (std::size_t i = 0; i < col.count(); ++i) {
+                const double a = col.components() == 4 && blend ? col.get(i, 3) : 1.0;
+                mesh->colors[i] = glm::vec4(col.get(i, 0) * a, col.get(i, 1) * a, col.get(i, 2) * a, a);
+            }
+        }
+
+        // Texture coordinates: the set the material's base colour texture reads (TEXCOORD_0 when it
+        // has none), with its KHR_texture_transform applied here (an affine map of the uvs commutes
+        // with perspective-correct interpolation, so this is exact); float or normalized unsigned
+        // byte/short (glTF's uv convention is ours). The material is this primitive's own, as is
+        // this mesh (cached by (mesh, primitive)), so neither choice reaches another draw.
+        const UvChoice choice = base_color_uvs(prim.material);
+        const std::string uv_name = "TEXCOORD_" + std::to_string(choice.set);
+        if (const auto uv_it = prim.attributes.find(uv_name); uv_it != prim.attributes.end()) {
+            const AccessorReader uv(model, uv_it->second, path, what + " " + uv_name);
+            if (uv.components() != 2) fail(path, uv.what() + ": " + uv_name + " must be VEC2");
+            const int ct = uv.component_type();
+            if (!texcoord_type_allowed(ct, uv.normalized()))
+                fail(path, uv.what() + ": " + uv_name + " must be float or normalized unsigned byte/short" +
+                               (quantized ? " (or byte/short, normalized or not, and unsigned byte/short with "
+                                            "KHR_mesh_quantization)"
+                                          : "") +
+                               ", got component type " + std::to_string(ct) + (uv.normalized() ? " (normalized)" : ""));
+            if (uv.count() != pos.count())
+                fail(path, uv.what() + ": " + uv_name + " has " + std::to_string(uv.count()) + " elements, POSITION " +
+                               std::to_string(pos.count()));
+            mesh->uvs.resize(uv.count());
+            for (std::size_t i = 0; i < uv.count(); ++i) {
+                const glm::dvec2 value(uv.get(i, 0), uv.get(i, 1));
+                mesh->uvs[i] = choice.transformed ? choice.apply(value) : glm::vec2(value);
+            }
+        }
+
+        // Normals: float (or normalized signed byte/short, as KHR_mesh_quantization allows).
+        if (const auto n_it = prim.attributes.find("NORMAL"); n_it != prim.attributes.end()) {
+            const AccessorReader nrm(model, n_it->second, path, what + " NORMAL");
+            if (nrm.components() != 3) fail(path, nrm.what() + ": NORMAL must be VEC3");
+            const int ct = nrm.component_type();
+            if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+                !((ct == TINYGLTF_COMPONENT_TYPE_BYTE || ct == TINYGLTF_COMPONENT_TYPE_SHORT) && nrm.normalized()))
+                fail(path, nrm.what() + ": NORMAL must be float or normalized byte/short, got component type " +
+                               std::to_string(ct));
+            if (nrm.count() != pos.count())
+                fail(path, nrm.what() + ": NORMAL has " + std::to_string(nrm.count()) + " elements, POSITION " +
+                               std::to_string(pos.count()));
+            mesh->normals.resize(nrm.count());
+            for (std::size_t i = 0; i < nrm.count(); ++i)
+                mesh->normals[i] = glm::vec3(nrm.get(i, 0), nrm.get(i, 1), nrm.get(i, 2));
+        }
+
+        // Triangles: the vertex sequence (the indices, or the vertices in order) assembled by mode.
+        mesh->triangles = assemble_triangles(prim.mode, vertex_sequence(prim, pos.count(), what), what);
+        mesh->validate(path + " " + what);
+        scene.meshes.push_back(mesh);
+        mesh_cache.emplace(key, mesh);
+        return mesh;
+    }
+
+    void add_node(int index, const glm::dmat4& parent, int depth) {
+        if (index < 0 || static_cast<std::size_t>(index) >= model.nodes.size())
+            fail(path, "node " + std::to_string(index) + " does not exist (the file has " +
+                           std::to_string(model.nodes.size()) + " nodes)");
+        if (on_path[index] || depth > kMaxNodeDepth)
+            fail(path, "node " + std::to_string(index) + " is its own ancestor (a cycle in the node hierarchy)");
+        on_path[index] = true;
+        const tinygltf::Node& node = model.nodes[index];
+        const glm::dmat4 world = parent * node_matrix(node, path, index);
+        for (int col = 0; col < 4; ++col)
+            for (int row = 0; row < 4; ++row)
+                if (!std::isfinite(world[col][row]))
+                    fail(path, "node " + std::to_string(index) + ": its world matrix is not finite");
+
+        if (node.mesh >= 0) {
+            if (static_cast<std::size_t>(node.mesh) >= model.meshes.size())
+                fail(path, "node " + std::to_string(index) + ": mesh " + std::to_string(node.mesh) + " does not exist");
+            const tinygltf::Mesh& m = model.meshes[node.mesh];
+            for (std::size_t p = 0; p < m.primitives.size(); ++p) {
+                const tinygltf::Primitive& prim = m.primitives[p];
+                if (!draws_triangles(prim.mode)) {
+                    ++skipped_primitives;
+                    continue;
+                }
+                Draw draw;
+                draw.mesh = primitive_mesh(node.mesh, static_cast<int>(p)).get();
+                draw.model = world;
+                apply_material(draw, prim, node.mesh, static_cast<int>(p));
+                scene.draws.push_back(draw);
+            }
+        }
+
+        if (node.camera >= 0) {
+            if (static_cast<std::size_t>(node.camera) >= model.cameras.size())
+                fail(path, "node " + std::to_string(index) + ": camera " + std::to_string(node.camera) + " does not exist");
+            scene.cameras.push_back(make_camera(model.cameras[node.camera], node.camera, world));
+        }
+
+        for (int child : node.children) add_node(child, world, depth + 1);
+        on_path[index] = false;
+    }
+
+    NamedCamera make_camera(const tinygltf::Camera& c, int index, const glm::dmat4& world) const {
+        const std::string what = "camera " + std::to_string(index) + " ('" + c.name + "')";
+        NamedCamera cam;
+        cam.name = c.name.empty() ? "camera " + std::to_string(index) : c.name;
+        cam.view = glm::inverse(world);
+        for (int col = 0; col < 4; ++col)
+            for (int row = 0; row < 4; ++row)
+                if (!std::isfinite(cam.view[col][row])) fail(path, what + ": its node's world matrix is singular");
+        if (c.type == "perspective") {
+            const auto& p = c.perspective;
+            cam.projection = NamedCamera::Projection::perspective;
+            cam.yfov = p.yfov;
+            cam.aspect_ratio = p.aspectRatio;
+            cam.znear = p.znear;
+            cam.zfar = p.zfar > 0.0 ? p.zfar : kInfiniteFar;  // tinygltf: 0 = not given = infinite
+            if (!(cam.yfov > 0.0 && cam.yfov < M_PI)) fail(path, what + ": yfov must be in (0, pi), got " + std::to_string(cam.yfov));
+            if (!(cam.znear > 0.0 && std::isfinite(cam.znear))) fail(path, what + ": znear must be > 0");
+            if (!(cam.zfar > cam.znear)) fail(path, what + ": zfar must be > znear");
+            if (!(cam.aspect_ratio >= 0.0 && std::isfinite(cam.aspect_ratio))) fail(path, what + ": aspectRatio must be > 0");
+        } else if (c.type == "orthographic") {
+            const auto& o = c.orthographic;
+            cam.projection = NamedCamera::Projection::orthographic;
+            cam.xmag = o.xmag;
+            cam.ymag = o.ymag;
+            cam.znear = o.znear;
+            cam.zfar = o.zfar;
+            if (!(cam.xmag != 0.0 && cam.ymag != 0.0 && std::isfinite(cam.xmag) && std::isfinite(cam.ymag)))
+                fail(path, what + ": xmag and ymag must be finite and non-zero");
+            if (!(std::isfinite(cam.znear) && std::isfinite(cam.zfar) && cam.zfar > cam.znear && cam.znear >= 0.0))
+                fail(path, what + ": expected 0 <= znear < zfar, both finite");
+        } else {
+            fail(path, what + ": unknown camera type '" + c.type + "'");
+        }
+        return cam;
+    }
+};
+
+/// The glTF extensions a file may list in extensionsRequired and still load as its author meant:
+/// those this loader reads (KHR_texture_transform on the base colour texture; KHR_mesh_quantization's
+/// integer POSITION, NORMAL and TEXCOORD_n) and those that do not change what it draws
+/// (KHR_materials_unlit: its renders are unlit anyway).
+const std::set<std::string> kSupportedRequiredExtensions = {"KHR_materials_unlit", "KHR_mesh_quantization",
+                                                            "KHR_texture_transform"};
+
+/// A file that requires another extension (compressed geometry, other image formats, …) cannot
+/// be drawn right: an error naming it. tinygltf only records the list, and without this the load
+/// failed later on what the extension changes, e.g. "accessor[1] invalid bufferView" for Draco.
+void check_required_extensions(const tinygltf::Model& model, const std::string& path) {
+    for (const std::string& extension : model.extensionsRequired) {
+        if (kSupportedRequiredExtensions.count(extension)) continue;
+        std::string supported;
+        for (const std::string& e : kSupportedRequiredExtensions) supported += (supported.empty() ? "" : ", ") + e;
+        fail(path, "the file requires the glTF extension '" + extension +
+                       "', which this loader does not support (it supports " + supported + ")");
+    }
+}
+
+// tinygltf's FileExists callback, for regular files only: a buffer whose uri named a directory
+// was opened and its "size" allocated (std::bad_alloc).
+bool regular_file_exists(const std::string& path, void*) {
+    std::error_code ec;
+    return std::filesystem::is_regular_file(path, ec);
+}
+
+}  // namespace
+
+LoadedScene load_gltf(const std::string& path, bool binary) {
+    tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks({regular_file_exists, tinygltf::ExpandFilePath, tinygltf::ReadWholeFile,
+                           tinygltf::WriteWholeFile, nullptr});
+    EmbeddedImages embedded;
+    loader.SetImageLoader(keep_data_uri_image, &embedded);
+    tinygltf::Model model;
+    std::string err, warn;
+    bool ok = false;
+    try {
+        ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
+                    : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    } catch (const std::exception& e) {  // e.g. a JSON parser exception
+        fail(path, std::string("cannot parse glTF: ") + e.what());
+    }
+    // tinygltf reads extensionsRequired before the buffers and accessors, so the list is there even
+    // when the load failed on what an unsupported extension changes: that is the error to report.
+    check_required_extensions(model, path);
+    if (!ok) fail(path, "cannot read glTF: " + trim(err.empty() ? warn : err));
+
+    GltfLoader g(model, path, embedded);
+    // tinygltf's notes about external image files it could not read are dropped: images are
+    // loaded (or warned about, naming the material) by image_texture.
+    std::istringstream lines(warn);
+    std::string kept, line;
+    while (std::getline(lines, line))
+        if (line.rfind("File not found : ", 0) != 0 && line.rfind("File read error : ", 0) != 0 &&
+            line.rfind("File is empty : ", 0) != 0 && line.rfind("Failed to load external 'uri' for image[", 0) != 0)
+            kept += line + "\n";
+    add_warnings(g.scene.warnings, path, kept);
+
+    // Roots: the default scene, else scene 0, else every node that is no other node's child.
+    std::vector<int> roots;
+    if (!model.scenes.empty()) {
+        int s = model.defaultScene;
+        if (s < 0) s = 0;
+        if (static_cast<std::size_t>(s) >= model.scenes.size())
+            fail(path, "default scene " + std::to_string(s) + " does not exist");
+        roots = model.scenes[s].nodes;
+    } else {
+        std::vector<bool> is_child(model.nodes.size(), false);
+        for (const auto& n : model.nodes)
+            for (int c : n.children)
+                if (c >= 0 && static_cast<std::size_t>(c) < model.nodes.size()) is_child[c] = true;
+        for (std::size_t i = 0; i < model.nodes.size(); ++i)
+            if (!is_child[i]) roots.push_back(static_cast<int>(i));
+    }
+    for (int r : roots) g.add_node(r, glm::dmat4(1.0), 0);
+    if (g.skipped_primitives)
+        g.scene.warnings.push_back(path + ": skipped " + std::to_string(g.skipped_primitives) +
+                                   " primitive(s) of mode POINTS or LINES, or of an unknown mode (only triangles "
+                                   "are drawn)");
+    return std::move(g.scene);
+}
+
+}  // namespace scene_files
+}  // namespace mipraster
