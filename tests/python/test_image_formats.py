@@ -377,3 +377,19 @@ def test_truncated_file_raises_os_error_naming_it(tmp_path, suffix, keep):
     assert info.value.filename == str(path)
     with pytest.raises(OSError, match="cut"):
         mr.Texture.from_file(path)
+
+
+# --- linear data from any integer format --------------------------------------------------------
+
+@pytest.mark.parametrize("suffix, options", [
+    (".png", {}), (".tga", {}), (".bmp", {}), (".tif", {}), (".webp", {"lossless": True, "exact": True}),
+], ids=lambda v: v if isinstance(v, str) else "")
+def test_srgb_false_reads_codes_as_linear_data(tmp_path, suffix, options):
+    """Normal and roughness maps: code / 255, exactly, in every format (alpha still premultiplies)."""
+    codes = random_codes((5, 6, 4 if suffix != ".bmp" else 3), seed=18)
+    if suffix == ".webp":
+        codes[..., 3] = 255  # OpenImageIO premultiplies WebP in 8 bits: exact only when opaque
+    Image.fromarray(codes).save(tmp_path / ("d" + suffix), **options)
+    expected = expected_linear(codes, srgb=False)
+    assert_decoded(mr.read_image(tmp_path / ("d" + suffix), srgb=False), expected)
+    assert_decoded(mr.Texture.from_file(tmp_path / ("d" + suffix), srgb=False).level(0), expected)
