@@ -27,13 +27,15 @@ namespace {
     throw py::error_already_set();
 }
 
-py::array_t<float> read_image_py(const std::string& path) {
+py::array_t<float> read_image_py(const std::string& path, bool srgb) {
     Image image;
     std::string failure;
     {
         py::gil_scoped_release release;
         try {
-            image = read_image(path);
+            ImageReadOptions options;
+            options.srgb = srgb;
+            image = read_image(path, options);
         } catch (const std::runtime_error& e) {
             failure = e.what();
             if (failure.empty()) failure = "read_image: cannot read '" + path + "'";
@@ -152,9 +154,9 @@ py::dict load_scene_py(const std::string& path) {
 PYBIND11_MODULE(_image, m) {
     using namespace mipraster::bindings;
     m.doc() = "mipraster's image files (OpenImageIO): PNG (sRGB 8-bit) and EXR (linear float) output, any input.";
-    m.def("read_image", &read_image_py, py::arg("path"),
+    m.def("read_image", &read_image_py, py::arg("path"), py::arg("srgb") = true,
           "Reads any file OpenImageIO reads into (H, W, 4) float32, linear premultiplied RGBA. 8-bit and\n"
-          "16-bit files are decoded from sRGB with straight alpha; float files are read as they are.\n"
+          "16-bit files are decoded from sRGB (srgb=False: code / max code); float files are read as they are.\n"
           "Raises OSError (with .filename) when the file is missing, unreadable or corrupt.");
     m.def("write_image", &write_image_py, py::arg("path"), py::arg("image"),
           "Writes (H, W, C) float32 (C = 1, 3 or 4; 4 = linear premultiplied RGBA) or (H, W): .png is sRGB\n"

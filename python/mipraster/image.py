@@ -58,20 +58,25 @@ def _float_image(image: Any, name: str) -> np.ndarray:
     return a
 
 
-def read_image(path: PathLike) -> np.ndarray:
+def read_image(path: PathLike, srgb: bool = True) -> np.ndarray:
     """Reads an image file into ``(H, W, 4)`` float32, linear premultiplied RGBA.
 
-    8- and 16-bit files (PNG, JPEG, ...) are decoded from sRGB with straight alpha; float files
+    8- and 16-bit files (PNG, JPEG, ...) are decoded from sRGB, alpha multiplied in linear (colour
+    stored premultiplied, as in TIFFs with associated alpha, is divided out first); float files
     (EXR, HDR, float TIFF) are read as they are. Grey becomes (g, g, g, 1), RGB gets alpha 1.
+    File transfer metadata (PNG gAMA/iCCP) and EXIF orientation are not applied.
+    ``srgb=False`` reads integer files as linear data (code / max code), e.g. normal maps.
 
     Raises:
         FileNotFoundError: there is no such file.
-        OSError: the file cannot be read (the message names the path; ``.filename`` is set).
+        OSError: the file cannot be read, or is truncated or corrupt (the message names the path;
+            ``.filename`` is set).
     """
     p = _path(path)
+    srgb = _checks.flag(srgb, "srgb")
     if not os.path.exists(p):
         raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), p)
-    return _image_module().read_image(p)
+    return _image_module().read_image(p, srgb)
 
 
 def write_image(path: PathLike, image: Any) -> None:

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 import os
-import struct
 from dataclasses import dataclass, field
 from typing import Any, Dict, Optional, Tuple, Union
 
@@ -302,15 +301,13 @@ class Texture:
             path: any file OpenImageIO reads (PNG, JPEG, EXR, HDR, TIFF, ...).
             srgb: for files of integer values (8- and 16-bit PNG, JPEG, ...): colour is
                 sRGB-encoded (the default), or, with False, linear data such as normal or
-                roughness maps, read as code / max code. Float files (EXR, HDR, PFM, float TIFF)
-                are linear and premultiplied whatever ``srgb`` says.
+                roughness maps, read as code / max code (any format). Float files (EXR, HDR, PFM,
+                float TIFF) are linear whatever ``srgb`` says.
             name: defaults to the path.
 
         Raises:
             FileNotFoundError: there is no such file.
             OSError: the file cannot be read.
-            ValueError: ``srgb=False`` for a file whose format this cannot tell integer from float
-                (formats other than PNG, JPEG, GIF, BMP, PNM, WebP, TIFF, EXR, HDR and PFM).
         """
         from .image import _path, read_image
 
@@ -318,15 +315,7 @@ class Texture:
         srgb = _checks.flag(srgb, "srgb")
         if name is not None and not isinstance(name, str):
             raise TypeError(f"name: expected str or None, got {type(name).__name__}")
-        rgba = read_image(p)  # linear premultiplied RGBA float32; integer files decoded from sRGB
-        if not srgb and _stores_integers(p):
-            # Undo read_image's sRGB decoding: colour = encode(premultiplied / alpha); alpha 0
-            # texels are (0, 0, 0, 0) either way.
-            alpha = rgba[..., 3:]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                straight = np.where(alpha > 0, rgba[..., :3] / alpha, 0.0)
-            rgba = np.concatenate([_core.linear_to_srgb(straight).astype(np.float32), alpha], axis=-1)
-            return cls(rgba, premultiplied=False, name=p if name is None else name)
+        rgba = read_image(p, srgb=srgb)  # linear premultiplied RGBA float32
         return cls(rgba, premultiplied=True, name=p if name is None else name)
 
     @classmethod
@@ -438,53 +427,6 @@ def _check_size(height: int, width: int) -> None:
     if needed > _core.MAX_TEXTURE_BYTES:
         raise ValueError(f"texels: {width}x{height} needs {needed >> 20} MiB as RGBA float; the limit is "
                          f"{_core.MAX_TEXTURE_BYTES >> 20} MiB")
-
-
-# --- file formats: does a file hold integer (sRGB-encodable) or float values? ------------------
-
-_INTEGER_MAGIC = (b"\x89PNG\r\n\x1a\n", b"\xff\xd8\xff", b"GIF87a", b"GIF89a", b"BM",
-                  b"P1", b"P2", b"P3", b"P4", b"P5", b"P6", b"P7")
-_FLOAT_MAGIC = (b"\x76\x2f\x31\x01", b"#?RADIANCE", b"#?RGBE", b"PF", b"Pf")
-
-
-def _stores_integers(path: str) -> bool:
-    """True for files of integer values (PNG, JPEG, GIF, BMP, PNM, WebP, integer TIFF), False for
-    float files (EXR, HDR, PFM, float TIFF); ValueError when the format is not one of these."""
-    with open(path, "rb") as f:
-        head = f.read(16)
-        if head.startswith(_FLOAT_MAGIC):
-            return False
-        if head.startswith(_INTEGER_MAGIC) or (head[:4] == b"RIFF" and head[8:12] == b"WEBP"):
-            return True
-        if head[:4] in (b"II*\x00", b"MM\x00*"):
-            return not _tiff_is_float(f, head)
-    raise ValueError(f"srgb: cannot tell whether {path!r} stores integer or float values (srgb=False is supported "
-                     "for PNG, JPEG, GIF, BMP, PNM, WebP, TIFF, EXR, HDR and PFM files); read it yourself and "
-                     "pass the codes to Texture(codes, srgb=False)")
-
-
-def _tiff_is_float(f: Any, head: bytes) -> bool:
-    """Whether the first image of a (classic) TIFF has SampleFormat 3 (IEEE float)."""
-    order = "<" if head[:2] == b"II" else ">"
-    (offset,) = struct.unpack(order + "I", head[4:8])
-    f.seek(offset)
-    raw = f.read(2)
-    if len(raw) < 2:
-        return False
-    (count,) = struct.unpack(order + "H", raw)
-    for _ in range(count):
-        entry = f.read(12)
-        if len(entry) < 12:
-            break
-        tag, kind, n = struct.unpack(order + "HHI", entry[:8])
-        if tag == 339 and kind == 3:  # SampleFormat (SHORT per channel): 1 uint, 2 int, 3 IEEE float
-            if n > 2:  # more than 4 bytes of values: the field holds their offset
-                f.seek(struct.unpack(order + "I", entry[8:12])[0])
-                first = f.read(2)
-            else:
-                first = entry[8:10]
-            return len(first) == 2 and struct.unpack(order + "H", first)[0] == 3
-    return False
 
 
 # --- the texture cache ---------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -141,6 +142,27 @@ void check_gif_header(const unsigned char* b, std::size_t size, const std::strin
     check_read_size(b[6] | b[7] << 8, b[8] | b[9] << 8, 4, name);
 }
 
+enum class AlphaKind { none, straight, associated };
+
+// How the reader hands over alpha. OpenImageIO's convention: colour is associated (premultiplied)
+// unless the spec says "oiio:UnassociatedAlpha" (PNG, TGA and unassociated TIFF do, given the
+// hint). Its BMP and GIF readers return the file's straight alpha without saying so; its WebP
+// reader premultiplies the 8-bit codes itself and says nothing, and TIFFs with associated alpha
+// (ExtraSamples 1, as oiiotool writes them) and EXR are premultiplied in the file.
+AlphaKind alpha_kind(const OIIO::ImageInput& in, const OIIO::ImageSpec& spec) {
+    if (spec.get_int_attribute("oiio:UnassociatedAlpha", 0) != 0) return AlphaKind::straight;
+    const std::string format = in.format_name();
+    if (format == "bmp" || format == "gif") return AlphaKind::straight;
+    return AlphaKind::associated;
+}
+
+// Whether channel `c` of every pixel of `raw` (nch channels per pixel) is zero.
+bool all_zero(const std::vector<float>& raw, int nch, int c) {
+    for (std::size_t i = static_cast<std::size_t>(c); i < raw.size(); i += static_cast<std::size_t>(nch))
+        if (raw[i] != 0.0f) return false;
+    return true;
+}
+
 // Step: read every channel of an opened file, decode and premultiply (read_image's contract;
 // `options` says how integer colour and alpha are taken). `name` is the path or the memory
 // image's name, for messages.
@@ -168,7 +190,10 @@ Image decode_image(OIIO::ImageInput& in, const std::string& name, const ImageRea
     } else {
         ok = in.read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, raw.data());
     }
-    if (!ok) throw std::runtime_error("read_image: cannot read pixels of '" + name + "': " + in.geterror());
+    // Some readers return true with an error recorded: a truncated JPEG (libjpeg pads it with
+    // grey) or TIFF (missing strips left as zeros). Those pixels are not the file's: refuse them.
+    if (!ok || in.has_error())
+        throw std::runtime_error("read_image: cannot read pixels of '" + name + "': " + in.geterror());
     in.close();
 
     // Pick the colour and alpha channels.
@@ -181,19 +206,27 @@ Image decode_image(OIIO::ImageInput& in, const std::string& name, const ImageRea
         if (c != alpha) colour[found++] = c;
     if (found < 3) colour = {colour[0], colour[0], colour[0]};  // grey (or grey + alpha)
 
-    // Decode integer files (sRGB or linear codes) and premultiply; float files are taken as
-    // they are (already premultiplied). ignore_alpha: alpha 1 and the straight colour.
+    const AlphaKind kind = alpha < 0 ? AlphaKind::none : alpha_kind(in, spec);
+    if (kind != AlphaKind::none && in.format_name() == std::string("bmp") && all_zero(raw, nch, alpha))
+        alpha = -1;  // a 32-bit BMP whose fourth byte is padding, not alpha (as browsers and stb_image read it)
+
+    // Per pixel: the straight colour (integer files: still encoded), then decode and premultiply in
+    // linear. ignore_alpha: alpha 1 and the straight colour.
     Image image(w, h, 4);
     for (std::size_t p = 0; p < n; ++p) {
         const float* src = &raw[p * nch];
         float* dst = &image.pixels[p * 4];
         const float a = alpha >= 0 ? src[alpha] : 1.0f;
+        const bool associated = alpha >= 0 && kind == AlphaKind::associated;
         for (int c = 0; c < 3; ++c) {
             const float v = src[colour[c]];
-            if (is_float) {
-                dst[c] = options.ignore_alpha && a > 0.0f ? v / a : v;  // un-premultiply to drop alpha
+            if (is_float) {  // linear: associated alpha is kept as it is (an EXR's colour may exceed alpha)
+                const float straight = associated ? (a > 0.0f ? v / a : v) : v;
+                dst[c] = options.ignore_alpha ? straight : (associated ? v : v * a);
             } else {
-                const float linear = options.srgb ? srgb_to_linear(v) : v;
+                // Integer colour stored premultiplied was multiplied in its own (encoded) space.
+                const float encoded = associated ? (a > 0.0f ? std::min(v / a, 1.0f) : 0.0f) : v;
+                const float linear = options.srgb ? srgb_to_linear(encoded) : encoded;
                 dst[c] = options.ignore_alpha ? linear : linear * a;
             }
         }

@@ -23,15 +23,23 @@ namespace mipraster {
 void write_image(const std::string& path, const Image& image);
 
 /// Reads any file OpenImageIO can read into a linear, premultiplied RGBA float image (C = 4,
-/// row 0 at the top). Integer-typed files (8-bit PNG or JPEG, 16-bit PNG, …) are taken as
-/// sRGB-encoded with straight alpha: colour channels are decoded with `srgb_to_linear`, alpha
-/// is used linearly (code / max code), and colour is then multiplied by alpha. Float-typed
-/// files (EXR, HDR, float TIFF) are read as they are, already linear and premultiplied.
-/// Grey becomes (g, g, g, 1), grey+alpha (g, g, g, a), RGB gets alpha 1; channels past the
-/// fourth are ignored. Only the first subimage and MIP level is read.
+/// row 0 at the top, pixels in stored order: an EXIF orientation tag is not applied).
+/// Integer-typed files (8-bit PNG or JPEG, 16-bit PNG or TIFF, …) are taken as sRGB-encoded:
+/// colour channels are decoded with `srgb_to_linear`, alpha is used linearly (code / max code),
+/// and colour is then multiplied by alpha. Files whose colour is stored premultiplied (TIFF
+/// with associated alpha, and WebP, which OpenImageIO premultiplies as it decodes) are divided
+/// by alpha in their encoded space first. Float-typed files (EXR, HDR, float TIFF) are linear
+/// and kept as they are, multiplied by alpha only when the file says it is unassociated.
+/// Transfer-function metadata in the file (PNG gAMA, sRGB, iCCP; OpenImageIO's
+/// "oiio:ColorSpace") is ignored: the sample type and `ImageReadOptions::srgb` decide.
+/// Grey becomes (g, g, g, 1), grey+alpha (g, g, g, a), RGB gets alpha 1, palette images their
+/// palette colours (and tRNS alpha); channels past the fourth are ignored. A 32-bit BMP whose
+/// fourth byte is zero everywhere is opaque (that byte is padding). Only the first subimage and
+/// MIP level is read.
 /// Note: a 1-channel PNG from `write_image` holds plain (not sRGB) grey, but reading it back
 /// decodes it as sRGB like any 8-bit file; store data images as EXR to read them back exactly.
-/// Throws std::runtime_error naming the path when the file is missing, unreadable or corrupt.
+/// Throws std::runtime_error naming the path when the file is missing, unreadable or corrupt
+/// (truncated files too, including those OpenImageIO decodes with a warning).
 Image read_image(const std::string& path);
 
 /// How read_image decodes a file (the defaults are read_image(path)'s).
