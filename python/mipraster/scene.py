@@ -162,7 +162,7 @@ class Scene:
         """
         demo = _core.make_demo_scene(1.0)
         scene = cls()
-        meshes = {}
+        meshes: dict[int, Mesh] = {}
         for d in demo.draws:
             core_mesh = d.mesh
             mesh = meshes.setdefault(id(core_mesh), Mesh._from_core(core_mesh))
