@@ -46,8 +46,9 @@ def _export(s: Any, path: str) -> None:
     """The study scene's draws as arrays in an .npz (clip-space positions per triangle corner)."""
     core = s.camera.build(s.width, s.height)
     vp = np.asarray(core.projection) @ np.asarray(core.view)
-    arrays: dict[str, Any] = {"size": np.array([s.width, s.height]), "clear": np.asarray(s.clear_color, dtype=np.float32),
-              "reverse_z": np.array([s.camera.depth_convention == "reverse_z"])}
+    arrays: dict[str, Any] = {"size": np.array([s.width, s.height]),
+                              "clear": np.asarray(s.clear_color, dtype=np.float32),
+                              "reverse_z": np.array([s.camera.depth_convention == "reverse_z"])}
     for i, d in enumerate(s.scene.draws):
         tri = np.asarray(d.mesh.triangles).reshape(-1)
         pos = np.asarray(d.mesh.positions, dtype=np.float64)[tri]
