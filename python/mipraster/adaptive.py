@@ -189,10 +189,14 @@ def render_adaptive_settings(draws: List[Any], camera: Any, settings: Any, targe
         if refine is None and s_uniform is None:
             break
         uniform = uniform_ms <= refine_ms
-        settings.samples = s_uniform if uniform else refine[1]
+        if uniform:
+            assert s_uniform is not None  # (uniform_ms is infinite without it, refine_ms then finite)
+            settings.samples, chosen = s_uniform, np.flatnonzero([])
+        else:
+            assert refine is not None  # (refine_ms is infinite without it)
+            settings.samples, chosen = refine[1], np.flatnonzero(refine[0])
         if settings.pattern == _core.PatternKind.rotated:
             settings.pattern = _core.PatternKind.grid  # the rotated pattern has 4 samples only
-        chosen = None if uniform else np.flatnonzero(refine[0])
         settings.pixels = [] if uniform else chosen.tolist()
         again = _core.render(draws, camera, settings)
         if uniform:

@@ -99,8 +99,9 @@ def find_bench_dir(explicit: Optional[str] = None) -> str:
 def load_scenes_module(bench_dir: str) -> Any:
     """Imports the shared ``scenes.py`` from ``bench_dir``."""
     spec = importlib.util.spec_from_file_location("mipraster_bench_scenes", os.path.join(bench_dir, "scenes.py"))
+    if spec is None or spec.loader is None:
+        raise ImportError(f"cannot load scenes.py from {bench_dir}")
     module = importlib.util.module_from_spec(spec)
-    assert spec.loader is not None
     sys.modules[spec.name] = module  # dataclasses look their module up while the file executes
     spec.loader.exec_module(module)
     return module
@@ -244,6 +245,7 @@ def add_roofline(case: Case, limits: roofline.MachineLimits, spp: int, bench_sce
 
 def roofline_row(case: Case) -> Dict[str, Any]:
     """A row of roofline.markdown for a case that has its roofline."""
+    assert case.write_ms is not None and case.lookup_ms is not None, "add_roofline first"
     return {"scene": case.scene, "mode": case.mode, "threads": case.threads, "bytes_written": case.bytes_written,
             "lookups": case.lookups, "write_s": case.write_ms / 1e3, "lookup_s": case.lookup_ms / 1e3,
             "measured_ms": case.median_ms, "fraction": case.roofline_fraction}
@@ -345,7 +347,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         if anchor is None:
             anchor_failed = True  # (not available: the reason is printed once)
             continue
-        gl = next(iter(anchor.get("gl_info", {}).values()), {})
+        gl: Dict[str, Any] = next(iter(anchor.get("gl_info", {}).values()), {})
         gl_renderer = gl_renderer or gl.get("GL_RENDERER", "?")
         anchor_runs.update({(r["scene"], r["mode"], r["threads"]): r for r in anchor["runs"]})
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import os
 import time
-from typing import List, Tuple
+from typing import List, Optional, Tuple
 
 import numpy as np
 
@@ -40,7 +40,7 @@ def _best_of_with_cpu(repeat: int, call) -> Tuple[float, float]:
     return best
 
 
-def main(argv: List[str] = None) -> None:
+def main(argv: Optional[List[str]] = None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--sizes", default="32,64,128,256", help="output sides, comma-separated")
     p.add_argument("--window", type=int, default=11)

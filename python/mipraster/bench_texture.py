@@ -64,6 +64,7 @@ import statistics
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 EXE_NAME = "mipraster_bench_texture"
 ANCHOR_NAME = "anchor_oiio_texture.py"
@@ -266,7 +267,7 @@ def side_by_side(mip_err, mip_speed, oi_err, oi_speed) -> tuple[str, list[dict]]
     rows = []
     for fp in FOOTPRINTS:
         for mf, om in COMPARABLE:
-            row = {"footprint": fp, "mipraster": mf, "oiio": om}
+            row: dict[str, Any] = {"footprint": fp, "mipraster": mf, "oiio": om}
             for tex in TEXTURES:
                 me, oe = mip_err.get((tex, fp, mf)), (oi_err or {}).get((tex, fp, om))
                 row[f"{tex}_mae_mipraster"] = me["mae"] if me else None
@@ -371,6 +372,7 @@ def main(argv: list[str] | None = None) -> int:
             oiio_first = oiio_first or ores
             oiio_runs.append(oiio_speeds(ores))
 
+    assert mip_first is not None  # (--repeat >= 1)
     mip_speed = median_speeds(mip_runs)
     oi_speed = median_speeds(oiio_runs) if oiio_runs else None
     revision = source_revision()
@@ -384,7 +386,7 @@ def main(argv: list[str] | None = None) -> int:
     summary = {"exe": str(exe), "source_revision": revision, "repeat": a.repeat, "quick": a.quick, "comparable": COMPARABLE, "rows": rows,
                "mipraster_speed_runs": [{f"{k[0]}/{k[1]}": v for k, v in r.items()} for r in mip_runs],
                "oiio_speed_runs": [{f"{k[0]}/{k[1]}": v for k, v in r.items()} for r in oiio_runs]}
-    if oiio_first:
+    if oiio_first and oi_speed is not None:  # (both or neither: the anchor ran)
         goals_md, goal_rows = goals(rows)
         md.append(goals_md)
         summary["goals"] = goal_rows

@@ -24,7 +24,7 @@ import os
 import statistics
 import sys
 from dataclasses import asdict, dataclass
-from typing import Dict, List, Optional, Sequence
+from typing import Any, Dict, List, Optional, Sequence
 
 import numpy as np
 
@@ -142,7 +142,7 @@ def power_law_exponent(x: np.ndarray, t: np.ndarray) -> float:
     return best
 
 
-def fit(x: Sequence[float], t: Sequence[float]) -> Dict[str, float]:
+def fit(x: Sequence[float], t: Sequence[float]) -> Dict[str, Any]:
     """Fits of times t (any unit) against sizes x: linear (a, b); with an x·log2 x term (a2, b2,
     c2 and ``superlinear_share``, c2·x·log2 x over the fitted time at the largest x: negative
     when the curve bends down); the exponent p of t = a + k·x^p (1 is linear); and the marginal
@@ -166,17 +166,17 @@ def fit(x: Sequence[float], t: Sequence[float]) -> Dict[str, float]:
 
 # ---- report ------------------------------------------------------------------------------------------
 
-def fits_by_series(points: Sequence[Point]) -> Dict[str, Dict[str, float]]:
+def fits_by_series(points: Sequence[Point]) -> Dict[str, Dict[str, Any]]:
     """A fit per series with at least 3 timed points."""
     out = {}
     for series in dict.fromkeys(p.series for p in points):
-        timed = [p for p in points if p.series == series and p.median_ms is not None]
+        timed = [(p.x, p.median_ms) for p in points if p.series == series and p.median_ms is not None]
         if len(timed) >= 3:
-            out[series] = fit([p.x for p in timed], [p.median_ms for p in timed])
+            out[series] = fit([x for x, _ in timed], [t for _, t in timed])
     return out
 
 
-def markdown(points: Sequence[Point], fits: Dict[str, Dict[str, float]]) -> str:
+def markdown(points: Sequence[Point], fits: Dict[str, Dict[str, Any]]) -> str:
     """The points table and the fits table."""
     rows = ["| series | size | triangles | samples (W·H·S) | median ms | ns per unit |", "|---|---|---|---|---|---|"]
     for p in points:
@@ -193,7 +193,7 @@ def markdown(points: Sequence[Point], fits: Dict[str, Dict[str, float]]) -> str:
     return "\n".join(rows) + "\n"
 
 
-def plot(points: Sequence[Point], fits: Dict[str, Dict[str, float]], path: str) -> None:
+def plot(points: Sequence[Point], fits: Dict[str, Dict[str, Any]], path: str) -> None:
     """Log-log plots of both sweeps with their linear fits, as a small palette PNG."""
     import matplotlib
 
@@ -257,7 +257,7 @@ def run(out_dir: str, quick: bool = False) -> Dict[str, object]:
     print(table)
     with open(os.path.join(out_dir, "growth.md"), "w") as f:
         f.write(table)
-    report = {"points": [asdict(p) for p in points], "fits": fits}
+    report: Dict[str, object] = {"points": [asdict(p) for p in points], "fits": fits}
     with open(os.path.join(out_dir, "growth.json"), "w") as f:
         json.dump(report, f, indent=1)
     plot(points, fits, os.path.join(out_dir, "cost_growth.png"))

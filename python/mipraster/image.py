@@ -16,7 +16,7 @@ from . import _checks, _core
 
 __all__ = ["read_image", "write_image", "to_srgb8", "srgb_to_linear", "linear_to_srgb", "linear_to_srgb8"]
 
-PathLike = Union[str, "os.PathLike[str]"]
+PathLike = Union[str, bytes, "os.PathLike[str]", "os.PathLike[bytes]"]  # bytes: decoded as os.fsdecode does
 
 
 def _image_module() -> ModuleType:

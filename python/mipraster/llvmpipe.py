@@ -15,7 +15,7 @@ import os
 import subprocess
 import sys
 import tempfile
-from typing import Any, Optional, Tuple
+from typing import Any, Optional, Tuple, cast
 
 import numpy as np
 
@@ -46,8 +46,9 @@ def _export(s: Any, path: str) -> None:
     """The study scene's draws as arrays in an .npz (clip-space positions per triangle corner)."""
     core = s.camera.build(s.width, s.height)
     vp = np.asarray(core.projection) @ np.asarray(core.view)
-    arrays = {"size": np.array([s.width, s.height]), "clear": np.asarray(s.clear_color, dtype=np.float32),
-              "reverse_z": np.array([s.camera.depth_convention == "reverse_z"])}
+    arrays: dict[str, Any] = {"size": np.array([s.width, s.height]),
+                              "clear": np.asarray(s.clear_color, dtype=np.float32),
+                              "reverse_z": np.array([s.camera.depth_convention == "reverse_z"])}
     for i, d in enumerate(s.scene.draws):
         tri = np.asarray(d.mesh.triangles).reshape(-1)
         pos = np.asarray(d.mesh.positions, dtype=np.float64)[tri]
@@ -113,7 +114,8 @@ def _child(scene_path: str, mode: str, repeats: int, out_path: str) -> None:
     data = np.load(scene_path)
     w, h = (int(v) for v in data["size"])
     scale = 2 if mode == "ssaa4" else 1
-    ctx = moderngl.create_standalone_context(backend="egl")
+    # moderngl's stub types the **settings values as Dict[str, Any]; backend takes a str
+    ctx = moderngl.create_standalone_context(backend="egl")  # type: ignore[arg-type]
     prog = ctx.program(vertex_shader=_VS, fragment_shader=_FS)
     draws = []
     for i in range(int(data["draws"][0])):
@@ -141,14 +143,15 @@ def _child(scene_path: str, mode: str, repeats: int, out_path: str) -> None:
 
     def frame() -> np.ndarray:
         fbo.use()
-        ctx.clear(*(float(c) for c in clear), depth=0.0 if reverse else 1.0)
+        red, green, blue, alpha = (float(c) for c in clear)
+        ctx.clear(red, green, blue, alpha, depth=0.0 if reverse else 1.0)
         for vao, tex, depth_test in draws:
             if depth_test:
                 ctx.enable(moderngl.DEPTH_TEST)
                 ctx.depth_func = ">" if reverse else "<"
             else:
                 ctx.disable(moderngl.DEPTH_TEST)
-            prog["textured"].value = tex is not None
+            cast(moderngl.Uniform, prog["textured"]).value = tex is not None
             if tex is not None:
                 tex.use(0)
             vao.render(moderngl.TRIANGLES)

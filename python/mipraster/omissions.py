@@ -116,7 +116,7 @@ def colour_grid(textured_with: Optional[str] = None, depth_test: bool = True, co
         if colors == "none":
             vertex_colors, kwargs["color"] = None, (0.8, 0.6, 0.4, 1.0)
         elif colors == "white-vertex":
-            vertex_colors = np.tile(np.float32([0.8, 0.6, 0.4, 1.0]), (len(positions), 1))
+            vertex_colors = np.tile(np.array([0.8, 0.6, 0.4, 1.0], np.float32), (len(positions), 1))
         uvs = positions[:, :2] * 0.5 + 0.5 if textured_with else None
         if textured_with:
             kwargs["texture"], kwargs["sampler"] = _white_texture(), mr.Sampler(filter=textured_with)
@@ -146,7 +146,7 @@ def ortho_textured(force_division: bool) -> Callable[[int, int], Dict[str, Any]]
         import mipraster as mr
 
         positions, tris, colors = _grid(width, height)
-        positions = positions * np.float32([width / height, 1.0, 1.0])
+        positions = positions * np.array([width / height, 1.0, 1.0], np.float32)
         uvs = positions[:, :2] * 0.5 + 0.5
         scene = mr.Scene()
         scene.add(mr.Mesh(positions, tris, colors=colors, uvs=uvs), interpolation="perspective",
@@ -165,8 +165,8 @@ def magnified_quad(width: int, height: int) -> Dict[str, Any]:
     """A full-screen quad showing a quarter of a fresh 1024² checker (magnified: level 0 only)."""
     import mipraster as mr
 
-    positions = np.float32([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]])
-    uvs = np.float32([[0, 0.5], [0.5, 0.5], [0.5, 0], [0, 0]])
+    positions = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], np.float32)
+    uvs = np.array([[0, 0.5], [0.5, 0.5], [0.5, 0], [0, 0]], np.float32)
     texture = mr.Texture(_checker(1024), srgb=False, name="checker 1024")
     scene = mr.Scene()
     scene.add(mr.Mesh(positions, np.array([[0, 1, 2], [0, 2, 3]]), uvs=uvs), texture=texture, sampler="trilinear")
@@ -188,7 +188,7 @@ def stacked_quads(width: int, height: int) -> Dict[str, Any]:
         uvs += [[0, 4], [4, 4], [4, 0], [0, 0]]
         tris += [[4 * k, 4 * k + 1, 4 * k + 2], [4 * k, 4 * k + 2, 4 * k + 3]]
     scene = mr.Scene()
-    scene.add(mr.Mesh(np.float32(positions), np.array(tris), uvs=np.float32(uvs)),
+    scene.add(mr.Mesh(np.array(positions, np.float32), np.array(tris), uvs=np.array(uvs, np.float32)),
               texture=mr.Texture(_checker(256), srgb=False, name="checker 256"), sampler="trilinear")
     return {"scene": scene, "camera": _ndc_camera()}
 

@@ -81,7 +81,7 @@ class RenderResult:
         self.error_map: Optional[np.ndarray] = raw.get("error_map")
         estimate = raw.get("error_estimate")
         self.error_estimate: Optional[float] = None if estimate is None else float(estimate)
-        self.error_probe: Optional[Any] = raw.get("error_probe")
+        self.error_probe: Optional[_core.ErrorProbe] = raw.get("error_probe")
         self.pixel_spp: Optional[np.ndarray] = raw.get("pixel_spp")
         self.adaptive: Optional[List[Any]] = raw.get("adaptive")
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Iterator, List, Optional, Tuple, Union
 
+import numpy as np
+
 from . import _checks, _core
 from .camera import Camera
 from .mesh import Mesh
@@ -57,14 +59,45 @@ class Draw:
         self._mesh = mesh
         self._draw = draw
 
-    mesh = property(lambda self: self._mesh, doc="The mesh drawn.")
-    model = property(lambda self: self._draw.model, doc="4×4 float64 model matrix (a copy).")
-    color = property(lambda self: self._draw.color, doc="Constant colour, linear premultiplied RGBA.")
-    depth_test = property(lambda self: self._draw.depth_test, doc="Whether samples are depth tested.")
-    depth_write = property(lambda self: self._draw.depth_write, doc="Whether passing samples store depth.")
-    blend = property(lambda self: self._draw.blend.name, doc="'replace', 'add' or 'over'.")
-    interpolation = property(lambda self: self._draw.interpolation.name, doc="'perspective', 'screen' or 'flat'.")
-    cull = property(lambda self: self._draw.cull.name, doc="'none', 'back' or 'front'.")
+    @property
+    def mesh(self) -> Mesh:
+        """The mesh drawn."""
+        return self._mesh
+
+    @property
+    def model(self) -> np.ndarray:
+        """4×4 float64 model matrix (a copy)."""
+        return self._draw.model
+
+    @property
+    def color(self) -> Tuple[float, float, float, float]:
+        """Constant colour, linear premultiplied RGBA."""
+        return self._draw.color
+
+    @property
+    def depth_test(self) -> bool:
+        """Whether samples are depth tested."""
+        return self._draw.depth_test
+
+    @property
+    def depth_write(self) -> bool:
+        """Whether passing samples store depth."""
+        return self._draw.depth_write
+
+    @property
+    def blend(self) -> str:
+        """'replace', 'add' or 'over'."""
+        return self._draw.blend.name
+
+    @property
+    def interpolation(self) -> str:
+        """'perspective', 'screen' or 'flat'."""
+        return self._draw.interpolation.name
+
+    @property
+    def cull(self) -> str:
+        """'none', 'back' or 'front'."""
+        return self._draw.cull.name
 
     @property
     def texture(self) -> Optional[Texture]:
@@ -162,7 +195,7 @@ class Scene:
         """
         demo = _core.make_demo_scene(1.0)
         scene = cls()
-        meshes = {}
+        meshes: dict[int, Mesh] = {}
         for d in demo.draws:
             core_mesh = d.mesh
             mesh = meshes.setdefault(id(core_mesh), Mesh._from_core(core_mesh))

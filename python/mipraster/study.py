@@ -26,7 +26,7 @@ import statistics
 import sys
 import time
 from dataclasses import dataclass, field, replace
-from typing import Dict, List, Optional, Sequence
+from typing import Any, Dict, List, Optional, Sequence
 
 import numpy as np
 
@@ -156,8 +156,9 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
         if k.target_error is not None:
             if estimate4 is None:
                 estimate4 = render(s.scene, s.camera, s.width, s.height, spp=4, estimate_error=True).error_estimate
+                assert estimate4 is not None  # estimate_error=True at 4 spp always estimates
             target = max(k.target_error * estimate4, 1e-6)
-        kwargs = dict(spp=k.spp, aa=k.aa, pattern=k.pattern, depth=False, target_error=target)
+        kwargs: Dict[str, Any] = dict(spp=k.spp, aa=k.aa, pattern=k.pattern, depth=False, target_error=target)
 
         def run(n_threads: int, scene=scene, kwargs=kwargs):  # bound now: runs are timed after the loop
             return render(scene, s.camera, s.width, s.height, threads=n_threads, **kwargs)
@@ -178,7 +179,7 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
         if target is not None:
             row.target_error = target
             row.mean_spp = float(result.pixel_spp.mean())
-            row.estimate = result.error_estimate
+            row.estimate = math.nan if result.error_estimate is None else result.error_estimate
             if result.error_probe is not None:
                 row.estimate_stderr = result.error_probe.stderr
                 row.estimate_bound = result.error_probe.upper_bound
@@ -187,9 +188,10 @@ def _measure_scene(s: StudyScene, sweep: Sequence[Knobs], repeats: int, threads:
                 f"{p.alternative_ms:.3g} ms)" for p in result.adaptive) if result.adaptive else "no pass after the first"
         else:
             probed = render(scene, s.camera, s.width, s.height, estimate_error=True, **kwargs)
-            row.estimate = probed.error_estimate
-            row.estimate_stderr, row.estimate_ms = probed.error_probe.stderr, probed.error_probe.ms
-            row.estimate_bound = probed.error_probe.upper_bound
+            row.estimate = math.nan if probed.error_estimate is None else probed.error_estimate
+            if probed.error_probe is not None:
+                row.estimate_stderr, row.estimate_ms = probed.error_probe.stderr, probed.error_probe.ms
+                row.estimate_bound = probed.error_probe.upper_bound
         if not math.isnan(row.estimate) and row.rmse > 0:
             row.estimate_ratio = row.estimate / row.rmse
         rows.append(row)
@@ -224,7 +226,6 @@ def _llvmpipe_rows(s: StudyScene, ref: np.ndarray, residual: float, repeats: int
     rows = []
     for mode in ("1x", "msaa4", "ssaa4"):
         times = {}
-        image = None
         for n in (1, 0):
             image, ms = llvmpipe.render_timed(s, mode, threads=n, repeats=repeats)
             times[n] = ms

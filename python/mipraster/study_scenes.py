@@ -192,7 +192,8 @@ def from_file(path: str, width: int = 160, height: int = 120) -> StudyScene:
         lo, hi = points.min(axis=0), points.max(axis=0)
         centre, extent = (lo + hi) / 2, float(np.linalg.norm(hi - lo)) or 1.0
         camera = Camera.look_at(eye=centre + np.array([0.0, 0.3, 1.2]) * extent, target=centre, fov_y=50.0)
-    clear = tuple(scene.clear_color) if scene.clear_color is not None else (0.5, 0.5, 0.5, 1.0)
+    r, g, b, a = scene.clear_color if scene.clear_color is not None else (0.5, 0.5, 0.5, 1.0)
+    clear = (r, g, b, a)
     name = os.path.splitext(os.path.basename(path))[0]
 
     def reference(quality: float = 1.0) -> Tuple[np.ndarray, float, str]:

@@ -71,6 +71,35 @@ def test_stubs_cover_the_extension_modules(module_name):
     assert (PACKAGE_DIR / "py.typed").exists()
 
 
+TESTS_DIR = pathlib.Path(__file__).resolve().parent
+REPO_DIR = TESTS_DIR.parents[1]
+
+
+def _run_typing_tool(args, cwd):
+    """`python ARGS` in this interpreter and environment (so on the package this test imported)."""
+    pytest.importorskip("mypy.stubtest", reason="mypy is not installed (pip install mypy; .ci/dev installs it)")
+    r = subprocess.run([sys.executable] + args, cwd=cwd, capture_output=True, text=True, timeout=600)
+    return r.returncode, (r.stdout + r.stderr).strip()
+
+
+def test_stubs_match_the_runtime_signatures(tmp_path):
+    # mypy's stubtest on the whole package (the .pyi stubs of _core and _image and the annotated
+    # Python modules) through tests/python/stubtest_pybind11.py, which gives it the argument lists
+    # pybind11 writes into docstrings: names, defaults, keyword-ness, properties, enum members.
+    code, out = _run_typing_tool(
+        [str(TESTS_DIR / "stubtest_pybind11.py"), "mipraster",
+         "--allowlist", str(TESTS_DIR / "stubtest_allowlist.txt"),
+         "--mypy-config-file", str(REPO_DIR / "pyproject.toml")], cwd=tmp_path)  # (its .mypy_cache there)
+    assert code == 0 and "Success" in out, out
+
+
+def test_the_package_type_checks(tmp_path):
+    # mypy on the package's source (with the stubs and pyproject.toml's [tool.mypy])
+    code, out = _run_typing_tool(["-m", "mypy", "--cache-dir", str(tmp_path / "mypy_cache"), "python/mipraster"],
+                                 cwd=REPO_DIR)
+    assert code == 0 and "Success" in out, out
+
+
 def test_public_api_is_documented():
     assert mr.__doc__ and "import mipraster" in mr.__doc__
     for name in mr.__all__:
