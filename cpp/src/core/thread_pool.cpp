@@ -1,5 +1,6 @@
 #include "mipraster/core/thread_pool.hpp"
 
+#include <chrono>
 #include <stdexcept>
 #include <string>
 
@@ -27,9 +28,29 @@ ThreadPool::~ThreadPool() {
         std::lock_guard<std::mutex> lock(mutex_);
         stop_ = true;
     }
+    published_generation_.fetch_add(1, std::memory_order_release);  // (ends a worker's spin)
     wake_.notify_all();
     for (auto& t : workers_) t.join();
 }
+
+namespace {
+
+// Spins until done() or kPoolSpin has passed; true when done() held.
+template <typename Done>
+bool spin_until(const Done& done) {
+    const auto until = std::chrono::steady_clock::now() + kPoolSpin;
+    for (;;) {
+        for (int i = 0; i < 32; ++i) {
+            if (done()) return true;
+#if defined(__x86_64__) || defined(__i386__)
+            __builtin_ia32_pause();  // (lets the other hyper-thread run, and saves power)
+#endif
+        }
+        if (std::chrono::steady_clock::now() >= until) return false;
+    }
+}
+
+}  // namespace
 
 void ThreadPool::run_tasks(std::unique_lock<std::mutex>& lock) {
     // Takes indices one at a time under the lock and runs each task unlocked.
@@ -49,7 +70,7 @@ void ThreadPool::run_tasks(std::unique_lock<std::mutex>& lock) {
             finished_ += count_ - next_;  // the tasks not handed out will not run: done with them too
             next_ = count_;               // (stop handing out work)
         }
-        ++finished_;
+        if (++finished_ == count_) all_finished_.store(true, std::memory_order_release);
     }
 }
 
@@ -57,6 +78,11 @@ void ThreadPool::worker_loop() {
     std::size_t seen = 0;
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
+        if (!stop_ && generation_ == seen) {  // the next parallel_for may be microseconds away
+            lock.unlock();
+            spin_until([&] { return published_generation_.load(std::memory_order_acquire) != seen; });
+            lock.lock();
+        }
         wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
         if (stop_) return;
         seen = generation_;
@@ -80,8 +106,15 @@ void ThreadPool::parallel_for(std::size_t count, const std::function<void(std::s
     finished_ = 0;
     error_ = nullptr;
     ++generation_;
+    all_finished_.store(false, std::memory_order_relaxed);
+    published_generation_.store(generation_, std::memory_order_release);
     wake_.notify_all();
     run_tasks(lock);
+    if (finished_ != count_) {  // a worker runs the last tasks: watch for them before sleeping
+        lock.unlock();
+        spin_until([&] { return all_finished_.load(std::memory_order_acquire); });
+        lock.lock();
+    }
     done_.wait(lock, [&] { return finished_ == count_ && busy_workers_ == 0; });
     task_ = nullptr;
     if (error_) std::rethrow_exception(error_);

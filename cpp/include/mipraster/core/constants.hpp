@@ -1,5 +1,6 @@
 #pragma once
 // Every numeric constant of the pipeline, each with why it has its value and a check of its bound.
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 
@@ -86,6 +87,12 @@ static_assert(double(kMaxTexelMagnitude) * 2.0 * 65536.0 < 3.4e38, "the filters'
 inline constexpr double kProjectedAreaRoundingUlps = 8.0;
 static_assert(kProjectedAreaRoundingUlps >= 4.0 && kProjectedAreaRoundingUlps <= 64.0,
               "above the determinant's rounding, far below any triangle a snapped sample can see");
+
+/// How long a pool thread that ran out of work watches for more before it sleeps: waking a
+/// sleeping thread took tens of microseconds here, and a frame's stages hand work to the pool
+/// a few microseconds apart (a 640×480 frame takes under a millisecond on two threads).
+inline constexpr std::chrono::microseconds kPoolSpin{100};
+static_assert(kPoolSpin.count() > 0 && kPoolSpin.count() <= 1000, "a short spin: idle pools must not burn a core");
 
 /// Most threads a render may ask for.
 inline constexpr int kMaxThreads = 256;

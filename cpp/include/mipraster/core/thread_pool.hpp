@@ -1,6 +1,7 @@
 #pragma once
 // A small persistent thread pool: parallel_for hands out task indices; callers keep results
 // per task so output never depends on how many threads ran.
+#include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <functional>
@@ -35,6 +36,11 @@ private:
     const std::function<void(std::size_t)>* task_ = nullptr;
     std::size_t count_ = 0, next_ = 0, finished_ = 0;
     std::size_t generation_ = 0;
+    // generation_ and "every task finished", readable without the lock: a worker that has just run
+    // out of work, and a caller that waits for the last task, watch them for a short while before
+    // they sleep on the condition variables (see kPoolSpin).
+    std::atomic<std::size_t> published_generation_{0};
+    std::atomic<bool> all_finished_{true};
     int busy_workers_ = 0;
     bool stop_ = false;
     std::exception_ptr error_;
