@@ -408,7 +408,8 @@ struct GltfLoader {
                 case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return WrapMode::clamp;
                 case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return WrapMode::mirror;
                 default:
-                    warn_once(what + ": " + field + " " + std::to_string(mode) + " is not a glTF wrap mode; using REPEAT");
+                    warn_once(what + ": " + field + " " + std::to_string(mode) +
+                              " is not a glTF wrap mode; using REPEAT");
                     return WrapMode::repeat;
             }
         };
@@ -424,8 +425,12 @@ struct GltfLoader {
         // minFilter = texel filter within a level + filter between levels.
         switch (g.minFilter) {
             case -1: break;
-            case TINYGLTF_TEXTURE_FILTER_NEAREST: s.min_filter = TexelFilter::nearest, s.mip_filter = MipFilter::none; break;
-            case TINYGLTF_TEXTURE_FILTER_LINEAR: s.min_filter = TexelFilter::linear, s.mip_filter = MipFilter::none; break;
+            case TINYGLTF_TEXTURE_FILTER_NEAREST:
+                s.min_filter = TexelFilter::nearest, s.mip_filter = MipFilter::none;
+                break;
+            case TINYGLTF_TEXTURE_FILTER_LINEAR:
+                s.min_filter = TexelFilter::linear, s.mip_filter = MipFilter::none;
+                break;
             case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST:
                 s.min_filter = TexelFilter::nearest, s.mip_filter = MipFilter::nearest;
                 break;
@@ -452,7 +457,8 @@ struct GltfLoader {
         const auto key = std::make_pair(index, ignore_alpha);
         if (auto it = texture_cache.find(key); it != texture_cache.end()) return it->second;
         const tinygltf::Image& image = model.images[index];
-        const std::string what = "images[" + std::to_string(index) + "]" + (image.name.empty() ? "" : " ('" + image.name + "')");
+        const std::string what =
+            "images[" + std::to_string(index) + "]" + (image.name.empty() ? "" : " ('" + image.name + "')");
         TextureFileOptions options;
         options.srgb = true;  // glTF base colour textures are sRGB
         options.ignore_alpha = ignore_alpha;
@@ -466,7 +472,8 @@ struct GltfLoader {
             if (!image.uri.empty()) {
                 if (image.uri.rfind("data:", 0) == 0) {  // tinygltf decodes PNG, JPEG, BMP and GIF data URIs only
                     source = what + " (data URI)";
-                    const std::string type = image.uri.substr(5, std::min<std::size_t>(image.uri.find_first_of(";,"), 64) - 5);
+                    const std::size_t type_end = std::min<std::size_t>(image.uri.find_first_of(";,"), 64);
+                    const std::string type = image.uri.substr(5, type_end - 5);
                     throw std::runtime_error("data URI of media type '" + type + "' is not supported");
                 }
                 const std::string uri = percent_decode(image.uri);
@@ -626,7 +633,8 @@ struct GltfLoader {
         const auto key = std::make_pair(mesh_index, prim_index);
         if (auto it = mesh_cache.find(key); it != mesh_cache.end()) return it->second;
         const tinygltf::Primitive& prim = model.meshes[mesh_index].primitives[prim_index];
-        const std::string what = "meshes[" + std::to_string(mesh_index) + "].primitives[" + std::to_string(prim_index) + "]";
+        const std::string what =
+            "meshes[" + std::to_string(mesh_index) + "].primitives[" + std::to_string(prim_index) + "]";
         auto mesh = std::make_shared<Mesh>();
 
         // Positions.
@@ -642,7 +650,8 @@ struct GltfLoader {
         // opaque otherwise (alpha is ignored for OPAQUE/MASK materials).
         if (const auto col_it = prim.attributes.find("COLOR_0"); col_it != prim.attributes.end()) {
             const AccessorReader col(model, col_it->second, path, what + " COLOR_0");
-            if (col.components() != 3 && col.components() != 4) fail(path, col.what() + ": COLOR_0 must be VEC3 or VEC4");
+            if (col.components() != 3 && col.components() != 4)
+                fail(path, col.what() + ": COLOR_0 must be VEC3 or VEC4");
             const int ct = col.component_type();
             if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
                 !((ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
@@ -745,7 +754,8 @@ struct GltfLoader {
 
         if (node.camera >= 0) {
             if (static_cast<std::size_t>(node.camera) >= model.cameras.size())
-                fail(path, "node " + std::to_string(index) + ": camera " + std::to_string(node.camera) + " does not exist");
+                fail(path, "node " + std::to_string(index) + ": camera " + std::to_string(node.camera) +
+                               " does not exist");
             scene.cameras.push_back(make_camera(model.cameras[node.camera], node.camera, world));
         }
 
@@ -768,10 +778,12 @@ struct GltfLoader {
             cam.aspect_ratio = p.aspectRatio;
             cam.znear = p.znear;
             cam.zfar = p.zfar > 0.0 ? p.zfar : kInfiniteFar;  // tinygltf: 0 = not given = infinite
-            if (!(cam.yfov > 0.0 && cam.yfov < M_PI)) fail(path, what + ": yfov must be in (0, pi), got " + std::to_string(cam.yfov));
+            if (!(cam.yfov > 0.0 && cam.yfov < M_PI))
+                fail(path, what + ": yfov must be in (0, pi), got " + std::to_string(cam.yfov));
             if (!(cam.znear > 0.0 && std::isfinite(cam.znear))) fail(path, what + ": znear must be > 0");
             if (!(cam.zfar > cam.znear)) fail(path, what + ": zfar must be > znear");
-            if (!(cam.aspect_ratio >= 0.0 && std::isfinite(cam.aspect_ratio))) fail(path, what + ": aspectRatio must be > 0");
+            if (!(cam.aspect_ratio >= 0.0 && std::isfinite(cam.aspect_ratio)))
+                fail(path, what + ": aspectRatio must be > 0");
         } else if (c.type == "orthographic") {
             const auto& o = c.orthographic;
             cam.projection = NamedCamera::Projection::orthographic;

@@ -56,7 +56,8 @@ LoadedScene load_scene(const std::string& path) {
     // colour: say so rather than leave a blank image unexplained.
     const bool any_triangle = std::any_of(scene.draws.begin(), scene.draws.end(),
                                           [](const Draw& d) { return d.mesh && !d.mesh->triangles.empty(); });
-    if (!any_triangle) scene.warnings.push_back(path + ": the file holds no triangles; a render shows only the clear colour");
+    if (!any_triangle)
+        scene.warnings.push_back(path + ": the file holds no triangles; a render shows only the clear colour");
     return scene;
 }
 
