@@ -100,6 +100,18 @@ def check_finite(a: np.ndarray, name: str) -> None:
     raise ValueError(f"{where} is {a[index]}; expected a finite number")
 
 
+def check_fits_float32(a: np.ndarray, name: str) -> None:
+    """ValueError naming the first finite element beyond float32's range (NaN and ±inf are left to
+    the caller): converted to float32 it would become ±inf."""
+    if a.dtype.kind != "f" or a.dtype.itemsize <= 4:
+        return
+    with np.errstate(invalid="ignore"):
+        big = np.isfinite(a) & (np.abs(a) > float(np.finfo(np.float32).max))
+    if big.any():
+        index = tuple(int(i) for i in np.argwhere(big)[0])
+        raise ValueError(f"{name}[{', '.join(map(str, index))}] = {a[index]} does not fit in float32")
+
+
 def to_float32(a: np.ndarray, name: str) -> np.ndarray:
     """A C-contiguous float32 copy (or the array itself when it is one); ValueError on float32 overflow."""
     with np.errstate(over="ignore", invalid="ignore"):

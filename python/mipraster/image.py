@@ -55,6 +55,7 @@ def _float_image(image: Any, name: str) -> np.ndarray:
         hint="; expected linear float values (premultiplied RGBA), e.g. mipraster.srgb_to_linear(rgb8 / 255)",
     )
     _checks.check_shape(a, name, (None, None), (None, None, 1), (None, None, 3), (None, None, 4), letters=("H", "W"))
+    _checks.check_fits_float32(a, name)  # (files and the C++ side hold float32: it would become inf)
     return a
 
 
@@ -90,7 +91,8 @@ def write_image(path: PathLike, image: Any) -> None:
 
     Raises:
         TypeError: a non-float image.
-        ValueError: a wrong shape or an unsupported extension.
+        ValueError: a wrong shape, a finite value beyond float32's range, or an unsupported
+            extension.
         OSError: the file cannot be written (the message names the path; ``.filename`` is set).
     """
     p = _path(path)

@@ -167,6 +167,7 @@ def interpolate(attributes: Any, raster: Raster, triangles: Any, mode: str = "pe
         attr = attr[:, None]
     _checks.check_shape(attr, "attributes", (raster.w.shape[0], None))
     _checks.check_finite(attr, "attributes")
+    _checks.check_fits_float32(attr, "attributes")  # (the float32 result would hold inf)
     tri = _triangles(triangles, raster.w.shape[0])
     mode = _checks.choice(mode, "mode", {m: m for m in INTERPOLATION_MODES})
     want_derivatives = _checks.flag(derivatives, "derivatives")

@@ -179,13 +179,29 @@ def test_corrupt_file_raises_os_error_naming_it(tmp_path):
         (np.zeros((4, 4, 2)), ValueError, ["image", "(H, W, 3)", "(4, 4, 2)"]),
         (np.zeros(16), ValueError, ["image", "(16,)"]),
         (np.zeros((0, 4, 4)), ValueError, ["empty"]),
+        # float64 beyond float32: it became inf with only numpy's overflow warning
+        (np.full((2, 3, 4), 1.0), None, None),
     ],
 )
 def test_write_image_refuses_bad_arrays(tmp_path, image, error, words):
+    if error is None:  # (the float64 case: one value past float32's largest)
+        image[1, 2, 0] = -1e39
+        error, words = ValueError, ["image[1, 2, 0] = -1e+39", "does not fit in float32"]
     with pytest.raises(error) as e:
         mr.write_image(tmp_path / "x.png", image)
     for w in words:
         assert w in str(e.value)
+
+
+@pytest.mark.parametrize("suffix", [".png", ".exr"])
+def test_write_image_keeps_nan_and_inf_of_float64_images(tmp_path, suffix):
+    # (check_fits_float32 refuses finite values only: non-finite ones are the caller's data)
+    image = np.full((2, 2, 4), 0.5)
+    image[0, 0, 0], image[0, 1, 1] = np.nan, np.inf
+    mr.write_image(tmp_path / f"x{suffix}", image)
+    if suffix == ".exr":
+        back = mr.read_image(tmp_path / "x.exr")
+        assert np.isnan(back[0, 0, 0]) and back[0, 1, 1] == np.inf
 
 
 def test_bad_path_type():

@@ -196,6 +196,10 @@ def test_interpolate_checks_its_inputs():
         mr.interpolate(np.zeros(pos.shape[0]), r, tris, mode="linear")
     with pytest.raises(TypeError, match="raster"):
         mr.interpolate(np.zeros(pos.shape[0]), {"triangle_id": r.triangle_id}, tris)
+    big = np.zeros((pos.shape[0], 2))
+    big[2, 1] = 1e39  # (float64: the float32 result held inf, with only numpy's overflow warning)
+    with pytest.raises(ValueError, match=r"attributes\[2, 1\] = 1e\+39 does not fit in float32"):
+        mr.interpolate(big, r, tris)
     if (r.triangle_id >= 0).any():
         with pytest.raises(ValueError, match="triangles"):
             mr.interpolate(np.zeros(pos.shape[0]), r, tris[:0])
