@@ -318,3 +318,21 @@ def test_polygons_cover_exactly_their_inside(tmp_path, name, reverse):
     x, y = np.meshgrid(centres, -centres)
     differ = ((alpha > 0) != inside(polygon, x, y)) & ~near_an_edge(polygon, x, y, 0.01 * 2 / size)
     assert not differ.any(), f"{differ.sum()} pixels differ"
+
+
+def test_a_polygon_beyond_the_ear_clipping_limit_is_fanned_with_a_warning(tmp_path):
+    # Ear clipping can take n³ steps: a hostile face of 10⁵ corners would not finish. Past 1024
+    # corners a polygon is fanned: exact for a convex one (here a 4000-gon), with a warning.
+    a = np.linspace(0, 2 * np.pi, 4000, endpoint=False)
+    polygon = np.stack([0.9 * np.cos(a), 0.9 * np.sin(a)], -1)
+    path = tmp_path / "circle.obj"
+    path.write_text("".join(f"v {float(x)!r} {float(y)!r} 0\n" for x, y in polygon)
+                    + "f " + " ".join(str(i + 1) for i in range(len(polygon))) + "\n")
+    scene, messages = load_quiet(path)
+    assert any("more than 1024 corners; triangulated as fans" in m for m in messages), messages
+    mesh = scene.draws[0].mesh
+    assert len(mesh.triangles) == len(polygon) - 2
+    assert (mesh.triangles[:, 0] == mesh.triangles[0, 0]).all()  # one fan around one corner
+    areas = [signed_area(mesh.positions[t, :2].astype(np.float64)) for t in mesh.triangles]
+    assert all(area > 0 for area in areas)
+    assert sum(areas) == pytest.approx(signed_area(polygon), rel=1e-6)

@@ -67,6 +67,12 @@ struct ObjGroup {
 constexpr std::size_t kMaxTinyobjCorners = std::numeric_limits<unsigned char>::max();
 static_assert(kMaxTinyobjCorners >= 4, "quads must pass through tinyobjloader");
 
+/// Polygons of more corners are fanned instead of ear-clipped (right for convex ones, such as a
+/// cylinder's cap): ear clipping can take n³ steps, and a hostile face of 10⁵ corners (a 700 KB
+/// line) would not finish. A 1024-corner star (the worst shape) takes 0.3 s.
+constexpr std::size_t kMaxEarClippingCorners = 1024;
+static_assert(kMaxEarClippingCorners > 4, "quads have their own split");
+
 // --- OBJ and MTL text ------------------------------------------------------------------------
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
@@ -578,8 +584,8 @@ double cross2(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
 /// A polygon's triangles as indices into `p` (its corners in order), keeping its winding. A quad
 /// is split along its shorter diagonal, as tinyobjloader did, unless that diagonal lies outside
 /// it (a concave quad); a larger polygon is ear-clipped in the plane of its Newell normal. What
-/// ear clipping cannot finish (a self-intersecting or degenerate polygon) is fanned, and
-/// `fanned` is set.
+/// ear clipping cannot finish (a self-intersecting or degenerate polygon) and polygons of more
+/// than kMaxEarClippingCorners corners are fanned, and `fanned` is set.
 std::vector<std::array<std::size_t, 3>> triangulate(const std::vector<glm::dvec3>& p, bool& fanned) {
     const std::size_t n = p.size();
     glm::dvec3 normal(0.0);  // Newell's method: robust for non-planar and concave polygons
@@ -596,6 +602,12 @@ std::vector<std::array<std::size_t, 3>> triangulate(const std::vector<glm::dvec3
         const bool valid02 = facing(0, 1, 2) && facing(0, 2, 3), valid13 = facing(0, 1, 3) && facing(1, 2, 3);
         if (split02 ? valid02 || !valid13 : !valid13 && valid02) return {{{0, 1, 2}}, {{0, 2, 3}}};
         return {{{0, 1, 3}}, {{1, 2, 3}}};
+    }
+    if (n > kMaxEarClippingCorners) {
+        fanned = true;
+        std::vector<std::array<std::size_t, 3>> fan;
+        for (std::size_t k = 1; k + 1 < n; ++k) fan.push_back({0, k, k + 1});
+        return fan;
     }
     // Project along the normal's largest axis, mirrored so that the polygon runs counter-clockwise.
     const glm::dvec3 a = glm::abs(normal);
@@ -767,7 +779,8 @@ LoadedScene load_obj(const std::string& path) {
     }
     if (fanned_faces > 0)
         scene.warnings.push_back(path + ": " + std::to_string(fanned_faces) +
-                                 " polygon(s) are self-intersecting or degenerate; triangulated as fans");
+                                 " polygon(s) are self-intersecting, degenerate or of more than " +
+                                 std::to_string(kMaxEarClippingCorners) + " corners; triangulated as fans");
 
     // Step 2: one compact mesh and draw per group; vertices are split by their (position,
     // texture coordinate, normal) indices, those the group keeps.
