@@ -35,18 +35,18 @@ ThreadPool::~ThreadPool() {
 
 namespace {
 
-// Spins until done() or kPoolSpin has passed; true when done() held.
+// Spins until done() or kPoolSpin has passed (the caller then takes the lock and checks).
 template <typename Done>
-bool spin_until(const Done& done) {
+void spin_until(const Done& done) {
     const auto until = std::chrono::steady_clock::now() + kPoolSpin;
     for (;;) {
         for (int i = 0; i < 32; ++i) {
-            if (done()) return true;
+            if (done()) return;
 #if defined(__x86_64__) || defined(__i386__)
             __builtin_ia32_pause();  // (lets the other hyper-thread run, and saves power)
 #endif
         }
-        if (std::chrono::steady_clock::now() >= until) return false;
+        if (std::chrono::steady_clock::now() >= until) return;
     }
 }
 

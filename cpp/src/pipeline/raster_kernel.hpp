@@ -90,7 +90,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     const int S = kMode == SampleMode::single ? 1 : pattern.count();
     constexpr std::int64_t kStep = kSubpixelOne;  // one pixel in fixed point
     TileBlocks blocks(target, S);
-    // Coverage masks four samples per vector (pixel_coverage_avx2).
+    // Coverage masks four samples per vector (pixel_coverage_avx2; also MSAA's depth tests,
+    // pixel_vectors below).
     const bool vector_masks = target.sample_rows && S % 4 == 0 && BatchSampler::widest_vector() == 8;
     std::optional<LookupQueue<kBlend, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
@@ -162,8 +163,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         // 12 % slower when every pixel took the vectors).
         const std::uint64_t all_samples = S == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << S) - 1;
         double offset0[kMaxSamples], offset1[kMaxSamples], offset2[kMaxSamples];
-        const bool pixel_vectors =
-            kMode == SampleMode::msaa && kDepth != DepthFunc::none && target.sample_rows && vector_masks;
+        const bool pixel_vectors = kMode == SampleMode::msaa && kDepth != DepthFunc::none && vector_masks;
         if (pixel_vectors)
             for (int s = 0; s < S; ++s)
                 offset0[s] = static_cast<double>(off0[s]), offset1[s] = static_cast<double>(off1[s]),
