@@ -308,15 +308,18 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
 
             // Coverage of the row's samples: sample s of pixel j is inside iff all three edge values
-            // are ≥ 0, i.e. the sign bit of their OR is clear. MSAA rows, and SSAA rows of
-            // kSampleRowMinPixels or more (here only without a depth test or past sample_rows_exact),
-            // get their masks in a pass of their own: plain integer adds, which vectorize with 64-bit
-            // compares (x86-64-v3; scalar on the baseline). The first sample stores each mask, the
-            // others add their bit: no clearing pass first, whose string stores the next loads would
-            // wait for. The other rows (all of them at one sample a pixel) test each pixel's samples
-            // in the pixel loop: faster for small triangles (many_small 1x raster 86.5 -> 68.7 ms,
-            // SSAA 4x -5 %), slower for long MSAA rows (plane MSAA 4x +5 %).
-            const bool masks = kMode == SampleMode::msaa || (kMode == SampleMode::ssaa && n >= kSampleRowMinPixels);
+            // are ≥ 0, i.e. the sign bit of their OR is clear. MSAA rows, SSAA rows of
+            // kSampleRowMinPixels or more (here only without a depth test or past sample_rows_exact)
+            // and, with the vector masks (four samples a vector), every SSAA row get their masks in a
+            // pass of their own: plain integer adds, which vectorize with 64-bit compares (x86-64-v3;
+            // scalar on the baseline). The first sample stores each mask, the others add their bit:
+            // no clearing pass first, whose string stores the next loads would wait for. The other
+            // rows (all of them at one sample a pixel) test each pixel's samples in the pixel loop:
+            // faster for small triangles (many_small 1x raster 86.5 -> 68.7 ms, SSAA 4x -5 % before
+            // the vector masks, which take another 12 % off), slower for long MSAA rows (plane MSAA
+            // 4x +5 %).
+            const bool masks = kMode == SampleMode::msaa ||
+                               (kMode == SampleMode::ssaa && (n >= kSampleRowMinPixels || vector_masks));
             std::uint64_t mask[kTileSize];
             const auto row_samples = [&](int s, auto&& store) {  // store(j, 1 if sample s of pixel j is inside)
                 std::int64_t e0 = row0 + off0[s], e1 = row1 + off1[s], e2 = row2 + off2[s];
