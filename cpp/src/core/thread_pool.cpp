@@ -47,6 +47,7 @@ void spin_until(const Done& done) {
 #endif
         }
         if (std::chrono::steady_clock::now() >= until) return;
+        std::this_thread::yield();  // a machine with more threads than cores: let one that has work run
     }
 }
 

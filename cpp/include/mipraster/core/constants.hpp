@@ -90,7 +90,8 @@ static_assert(kProjectedAreaRoundingUlps >= 4.0 && kProjectedAreaRoundingUlps <=
 
 /// How long a pool thread that ran out of work watches for more before it sleeps: waking a
 /// sleeping thread took tens of microseconds here, and a frame's stages hand work to the pool
-/// a few microseconds apart (a 640×480 frame takes under a millisecond on two threads).
+/// a few microseconds apart (a 640×480 frame takes under a millisecond on two threads). The spin
+/// yields its core every few hundred pauses, so that a busier machine's other threads can run.
 inline constexpr std::chrono::microseconds kPoolSpin{100};
 static_assert(kPoolSpin.count() > 0 && kPoolSpin.count() <= 1000, "a short spin: idle pools must not burn a core");
 
