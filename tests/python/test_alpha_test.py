@@ -2,6 +2,11 @@
 alpha is below the cutoff writes neither colour nor depth; one at or above it is written opaque, its colour
 divided by its alpha. The expected images are worked out in numpy from the texels, one texel per pixel
 (nearest filtering, texel centres on pixel centres), so every sample of a pixel reads its pixel's texel."""
+import base64
+import json
+import struct
+import warnings
+
 import numpy as np
 import pytest
 
@@ -111,3 +116,96 @@ def test_bad_cutoff_is_an_error_naming_it(bad, error):
 def test_core_draw_refuses_a_bad_cutoff_too():
     with pytest.raises(ValueError, match="alpha_cutoff"):
         mr._core.Draw(quad(0.0)._mesh, alpha_cutoff=1.5)
+
+
+# --- glTF alphaMode MASK -------------------------------------------------------------------------
+
+# A 2x2 texture, straight linear RGB with alpha: red (1), green (0), blue (0.2), white (0.4).
+GLTF_ALPHA = np.float32([[1.0, 0.0], [0.2, 0.4]])
+GLTF_RGB = np.float32([[[1, 0, 0], [0, 1, 0]], [[0, 0, 1], [1, 1, 1]]])
+
+
+def write_masked_gltf(tmp_path, material_extra):
+    """A quad filling [-1, 1]² at z = 0 textured with the 2x2 RGBA PNG above (embedded), nearest
+    filtering, its material's fields updated with `material_extra`, an orthographic camera at z = 5."""
+    mr.write_image(tmp_path / "mask.png", np.concatenate([GLTF_RGB * GLTF_ALPHA[..., None], GLTF_ALPHA[..., None]], -1))
+    png = (tmp_path / "mask.png").read_bytes()
+    positions = [-1, 1, 0, 1, 1, 0, 1, -1, 0, -1, -1, 0]
+    uvs = [0, 0, 1, 0, 1, 1, 0, 1]
+    buf = struct.pack("<12f", *positions) + struct.pack("<8f", *uvs) + struct.pack("<6H", 0, 2, 1, 0, 3, 2) + b"\0" * 4
+    material = {"doubleSided": True, "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, **material_extra}
+    doc = {
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}],
+        "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}],
+        "materials": [material],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33071}],
+        "images": [{"uri": "data:image/png;base64," + base64.b64encode(png).decode()}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2, "material": 0}]}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"},
+        ],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
+                        {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+                        {"buffer": 0, "byteOffset": 80, "byteLength": 12}],
+        "buffers": [{"byteLength": len(buf),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(buf).decode()}],
+    }
+    path = tmp_path / "masked.gltf"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def render_with_backdrop(path):
+    """The file's scene, then an opaque quad behind it (drawn after: it shows only where no depth was
+    written), through the file's camera; the loaded draw and the 32x32 colour image."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scene, cameras = mr.load_scene(path)
+    (d,) = scene.draws
+    scene.add(quad(-1.0, uvs=False), color=BEHIND)
+    return d, mr.render(scene, cameras[0], 32, 32).color
+
+
+def quadrants(color):
+    return np.array([color[8, 8], color[8, 24], color[24, 8], color[24, 24]])
+
+
+def test_gltf_mask_material_renders_holes_below_its_cutoff(tmp_path):
+    d, color = render_with_backdrop(write_masked_gltf(tmp_path, {"alphaMode": "MASK", "alphaCutoff": 0.3}))
+    assert d.alpha_cutoff == pytest.approx(0.3) and d.blend == "replace"
+    texels = d.texture.level(0).reshape(4, 4)  # the alpha is kept (premultiplied), not dropped
+    np.testing.assert_allclose(texels[:, 3], GLTF_ALPHA.reshape(4), atol=1 / 255)
+    got = quadrants(color)
+    # alpha 1 and 0.4 >= 0.3: the texel's colour, opaque; alpha 0 and 0.2: the quad behind.
+    for q in (0, 3):
+        np.testing.assert_allclose(got[q, :3], texels[q, :3] / texels[q, 3], atol=1e-6, err_msg=f"quadrant {q}")
+        np.testing.assert_allclose(got[q, :3], GLTF_RGB.reshape(4, 3)[q], atol=0.02, err_msg=f"quadrant {q}")
+        assert got[q, 3] == 1.0
+    for q in (1, 2):
+        np.testing.assert_array_equal(got[q], BEHIND, err_msg=f"quadrant {q}")
+
+
+def test_gltf_mask_default_cutoff_is_one_half(tmp_path):
+    d, color = render_with_backdrop(write_masked_gltf(tmp_path, {"alphaMode": "MASK"}))
+    assert d.alpha_cutoff == 0.5
+    got = quadrants(color)
+    np.testing.assert_array_equal(got[1], BEHIND)
+    np.testing.assert_array_equal(got[2], BEHIND)
+    np.testing.assert_array_equal(got[3], BEHIND)  # alpha 0.4 < 0.5
+    np.testing.assert_allclose(got[0], [1, 0, 0, 1], atol=1e-6)
+
+
+@pytest.mark.parametrize("extra", [{}, {"alphaMode": "OPAQUE", "alphaCutoff": 0.3}])
+def test_gltf_opaque_material_ignores_alpha_and_cutoff(tmp_path, extra):
+    d, color = render_with_backdrop(write_masked_gltf(tmp_path, extra))
+    assert d.alpha_cutoff is None
+    # The quadrants show the texture's straight colour, opaque: no holes, the quad behind hidden (the
+    # alpha-0 texel's colour did not survive the PNG's straight alpha: not compared).
+    np.testing.assert_allclose(quadrants(color)[[0, 2, 3], :3], GLTF_RGB.reshape(4, 3)[[0, 2, 3]], atol=0.02)
+    assert (color[..., 3] == 1.0).all()
+    assert not np.any(np.all(color == BEHIND, axis=-1))
