@@ -198,6 +198,33 @@ TEST(SceneFile, GlbLoads) {
     check_gltf_scene(mr::load_scene(write_file("scene.glb", glb_bytes(triangle_buffer()))));
 }
 
+TEST(SceneFile, GltfMaskKeepsVertexColourAlphaAndOpaqueDropsIt) {
+    // The scene's material as MASK: COLOR_0's alpha counts (premultiplied, as for BLEND) and the
+    // draw is alpha-tested, not blended; as OPAQUE the alpha is 1.
+    const std::vector<unsigned char> buffer = triangle_buffer();
+    const std::string json = gltf_json("\"uri\": \"data:application/octet-stream;base64," + base64(buffer) + "\", ",
+                                       buffer.size());
+    const float a = 128.0f / 255.0f;
+    for (const std::string mode : {"MASK", "OPAQUE"}) {
+        std::string text = json;
+        text.replace(text.find("\"BLEND\""), 7, "\"" + mode + "\"");
+        const auto s = mr::load_scene(write_file(mode + ".gltf", text));
+        ASSERT_EQ(s.meshes.size(), 1u);
+        const glm::vec4 c = s.meshes[0]->colors[1];
+        EXPECT_EQ(s.draws[0].state.blend, mr::BlendMode::replace) << mode;
+        if (mode == "MASK") {
+            EXPECT_NEAR(c.g, a, 1e-6);
+            EXPECT_NEAR(c.a, a, 1e-6);
+            EXPECT_EQ(s.draws[0].color, glm::vec4(0.25f, 0.125f, 0.5f, 0.5f));
+            EXPECT_EQ(s.draws[0].state.alpha_cutoff, 0.5f);
+        } else {
+            EXPECT_EQ(c, glm::vec4(0, 1, 0, 1));
+            EXPECT_EQ(s.draws[0].color, glm::vec4(0.5f, 0.25f, 1.0f, 1.0f));
+            EXPECT_FALSE(s.draws[0].state.alpha_cutoff);
+        }
+    }
+}
+
 TEST(SceneFile, GltfCameraAspectRatioFromTheFileWins) {
     std::string json = gltf_json("\"uri\": \"data:application/octet-stream;base64," + base64(triangle_buffer()) + "\", ", 56);
     const std::string from = R"("yfov": 0.8, "znear": 0.1)";
