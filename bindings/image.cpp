@@ -128,6 +128,7 @@ py::dict load_scene_py(const std::string& path) {
         draw["color"] = from_vec4(d.color);
         draw["blend"] = to_string(d.state.blend);
         draw["cull"] = to_string(d.state.cull);
+        draw["alpha_cutoff"] = d.state.alpha_cutoff ? py::object(py::float_(*d.state.alpha_cutoff)) : py::none();
         draw["texture"] = texture_index(d.texture);
         py::dict sampler;
         sampler["footprint"] = to_string(d.sampler.footprint);

@@ -77,7 +77,7 @@ std::shared_ptr<Mesh> make_mesh(const CArray<float>& positions, const CArray<std
 PyDraw make_draw(std::shared_ptr<Mesh> mesh, const std::optional<CArray<double>>& model,
                  const CArray<float>& color, bool depth_test, bool depth_write, BlendMode blend,
                  Interpolation interpolation, CullMode cull, const std::optional<Texture>& texture,
-                 const std::optional<Sampler>& sampler) {
+                 const std::optional<Sampler>& sampler, std::optional<float> alpha_cutoff) {
     if (!mesh) throw py::value_error("Draw: mesh is None");
     if (texture && *texture && !mesh->has_uvs())
         throw py::value_error("texture: the mesh has no uvs (give Mesh(..., uvs=...) to texture it)");
@@ -96,6 +96,8 @@ PyDraw make_draw(std::shared_ptr<Mesh> mesh, const std::optional<CArray<double>>
     d.draw.state.blend = blend;
     d.draw.state.interpolation = interpolation;
     d.draw.state.cull = cull;
+    d.draw.state.alpha_cutoff = alpha_cutoff;
+    d.draw.state.validate("Draw");  // (std::invalid_argument: a ValueError)
     if (texture) d.draw.texture = *texture;
     if (sampler) d.draw.sampler = *sampler;
     d.mesh = std::move(mesh);
@@ -255,12 +257,14 @@ void bind_scene(py::module_& m) {
     py::class_<PyDraw>(m, "Draw",
                        "One draw call: a mesh, its model matrix, a constant colour (premultiplied linear RGBA,\n"
                        "multiplied with the vertex colours), an optional base-colour texture with its sampler\n"
-                       "(multiplied in too) and the fixed-function state.")
+                       "(multiplied in too) and the fixed-function state. alpha_cutoff (None: off) alpha-tests\n"
+                       "it: a fragment whose shaded alpha is below it writes nothing, one at or above it is written\n"
+                       "opaque (rgb / alpha, alpha 1).")
         .def(py::init(&make_draw), py::arg("mesh"), py::arg("model") = py::none(),
              py::arg("color") = std::vector<float>{1.0f, 1.0f, 1.0f, 1.0f}, py::arg("depth_test") = true,
              py::arg("depth_write") = true, py::arg("blend") = BlendMode::replace,
              py::arg("interpolation") = Interpolation::perspective, py::arg("cull") = CullMode::none,
-             py::arg("texture") = py::none(), py::arg("sampler") = py::none())
+             py::arg("texture") = py::none(), py::arg("sampler") = py::none(), py::arg("alpha_cutoff") = py::none())
         .def_property_readonly("mesh", [](const PyDraw& d) { return d.mesh; })
         .def_property_readonly("model", [](const PyDraw& d) { return from_dmat4(d.draw.model); })
         .def_property_readonly("color", [](const PyDraw& d) { return from_vec4(d.draw.color); })
@@ -269,6 +273,7 @@ void bind_scene(py::module_& m) {
         .def_property_readonly("blend", [](const PyDraw& d) { return d.draw.state.blend; })
         .def_property_readonly("interpolation", [](const PyDraw& d) { return d.draw.state.interpolation; })
         .def_property_readonly("cull", [](const PyDraw& d) { return d.draw.state.cull; })
+        .def_property_readonly("alpha_cutoff", [](const PyDraw& d) { return d.draw.state.alpha_cutoff; })
         .def_property_readonly("texture",
                                [](const PyDraw& d) -> std::optional<Texture> {
                                    if (!d.draw.texture) return std::nullopt;

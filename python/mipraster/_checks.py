@@ -167,6 +167,17 @@ def real(value: Any, name: str) -> float:
     return float(value)
 
 
+def unit_or_none(value: Any, name: str) -> Optional[float]:
+    """None, or a real number in [0, 1] as a Python float; TypeError for bool, str, ..., ValueError
+    for NaN or a number outside [0, 1]."""
+    if value is None:
+        return None
+    v = real(value, name)
+    if not 0.0 <= v <= 1.0:  # (NaN fails too)
+        raise ValueError(f"{name}: expected a number in [0, 1] or None, got {v!r}")
+    return v
+
+
 def flag(value: Any, name: str) -> bool:
     """A bool (Python or numpy); TypeError otherwise, so that e.g. the string 'false' is refused."""
     if not isinstance(value, (bool, np.bool_)):

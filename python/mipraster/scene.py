@@ -49,6 +49,7 @@ class Draw:
         blend: ``"replace"``, ``"add"`` or ``"over"`` (premultiplied Porter–Duff over).
         interpolation: ``"perspective"``, ``"screen"`` (affine) or ``"flat"`` (first vertex).
         cull: ``"none"``, ``"back"`` or ``"front"`` (front faces are counter-clockwise on screen).
+        alpha_cutoff: the alpha test's cutoff in [0, 1] (glTF ``alphaMode: MASK``), or None: no test.
         texture: the base-colour :class:`Texture`, or None.
         sampler: the :class:`Sampler` of the texture.
     """
@@ -100,6 +101,11 @@ class Draw:
         return self._draw.cull.name
 
     @property
+    def alpha_cutoff(self) -> Optional[float]:
+        """The alpha test's cutoff (fragments with a lower alpha are discarded), or None: no test."""
+        return self._draw.alpha_cutoff
+
+    @property
     def texture(self) -> Optional[Texture]:
         """The base-colour texture, or None."""
         t = self._draw.texture
@@ -113,7 +119,7 @@ class Draw:
     def __repr__(self) -> str:
         return (f"Draw({self._mesh!r}, color={self.color}, depth_test={self.depth_test}, "
                 f"depth_write={self.depth_write}, blend={self.blend!r}, interpolation={self.interpolation!r}, "
-                f"cull={self.cull!r})")
+                f"cull={self.cull!r}, alpha_cutoff={self.alpha_cutoff!r})")
 
 
 class Scene:
@@ -132,7 +138,7 @@ class Scene:
     def add(self, mesh: Mesh, model: Any = None, color: Any = (1.0, 1.0, 1.0, 1.0), depth_test: bool = True,
             depth_write: bool = True, blend: str = "replace", interpolation: str = "perspective",
             cull: str = "none", texture: Optional[Texture] = None, sampler: Union[Sampler, str, None] = None,
-            material: Optional[Material] = None) -> Draw:
+            material: Optional[Material] = None, alpha_cutoff: Optional[float] = None) -> Draw:
         """Appends a draw of ``mesh`` and returns it.
 
         Args:
@@ -150,11 +156,18 @@ class Scene:
             blend: ``"replace"``, ``"add"`` or ``"over"``.
             interpolation: ``"perspective"``, ``"screen"`` or ``"flat"``.
             cull: ``"none"``, ``"back"`` or ``"front"``.
+            alpha_cutoff: alpha testing (glTF ``alphaMode: MASK``), a number in [0, 1]; None (the
+                default): off. A fragment whose shaded alpha (color × vertex colour × texture,
+                premultiplied) is below it is discarded: it writes neither colour nor depth. One at
+                or above it is written opaque: rgb divided by its alpha, alpha 1 (then ``blend``
+                applies). Texture lookups of such a draw take the reference path, one sample at a
+                time, and a render with one is not deferred.
 
         Raises:
-            TypeError: ``mesh`` is not a Mesh, a flag is not a bool, an option is not a string.
+            TypeError: ``mesh`` is not a Mesh, a flag is not a bool, an option is not a string,
+                ``alpha_cutoff`` is not a number or None.
             ValueError: a wrong matrix or colour shape, a non-finite entry, an unknown option name
-                (the message lists the accepted names).
+                (the message lists the accepted names), an ``alpha_cutoff`` outside [0, 1] or NaN.
         """
         if not isinstance(mesh, Mesh):
             raise TypeError(f"mesh: expected a mipraster.Mesh, got {type(mesh).__name__}")
@@ -181,6 +194,7 @@ class Scene:
             cull=_checks.choice(cull, "cull", CULL_MODES),
             texture=None if texture is None else texture._texture,
             sampler=core_sampler,
+            alpha_cutoff=_checks.unit_or_none(alpha_cutoff, "alpha_cutoff"),
         )
         item = Draw(mesh, draw)
         self.draws.append(item)

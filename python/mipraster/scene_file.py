@@ -7,7 +7,7 @@ and sparse accessors), vertex colours (linear), material colours (OBJ ``Kd``, gl
 ``baseColorFactor``, both linear), texture coordinates (OBJ ``vt`` with v flipped to the glTF
 convention; glTF ``KHR_texture_transform`` applied) and normals, base colour textures (OBJ
 ``map_Kd``, glTF ``baseColorTexture``; sRGB) with their samplers, glTF node transforms, alpha
-blending (``alphaMode: BLEND``), back-face culling of single-sided glTF materials, and glTF
+blending and testing (``alphaMode: BLEND`` and ``MASK``), back-face culling of single-sided glTF materials, and glTF
 cameras. A texture that cannot be read is replaced by a magenta/black checker, with a warning.
 """
 from __future__ import annotations
@@ -61,7 +61,9 @@ def load_scene(path: PathLike) -> Tuple[Scene, List[Camera]]:
     Returns:
         A :class:`Scene` with one draw per OBJ material or per glTF node primitive (model matrix =
         the node's world matrix; colour = the material's linear base colour, premultiplied for
-        ``BLEND`` materials, which blend ``"over"``; single-sided glTF materials cull back faces),
+        ``BLEND`` and ``MASK`` materials; ``BLEND`` materials blend ``"over"``, ``MASK`` materials are
+        alpha-tested with their ``alphaCutoff``, default 0.5, as ``draw.alpha_cutoff``; single-sided
+        glTF materials cull back faces),
         and the file's cameras in node order as :class:`Camera` objects (OBJ has none). A
         perspective camera uses the file's aspect ratio if it gives one, else the render's;
         reverse-Z depth, infinite far plane when the file gives no ``zfar``. The scene's
@@ -70,7 +72,7 @@ def load_scene(path: PathLike) -> Tuple[Scene, List[Camera]]:
         ``KHR_texture_transform`` applied; OBJ ``vt`` with v flipped, OBJ vertices split where a
         position has several texture coordinates or normals) and normals. A draw whose material
         has a base colour texture (glTF ``baseColorTexture``, OBJ ``map_Kd``, both decoded from
-        sRGB; the texture's alpha is ignored unless the material blends) gets it as
+        sRGB; the texture's alpha is ignored unless the material blends or masks) gets it as
         ``draw.texture``, with ``draw.sampler`` from the glTF sampler (wrap and filter enums;
         undefined filters are trilinear) or the default sampler (OBJ; ``-clamp on`` clamps). A
         texture file that is missing or unreadable does not stop the load: the draw gets an 8×8
@@ -100,7 +102,7 @@ def load_scene(path: PathLike) -> Tuple[Scene, List[Camera]]:
         texture = None if d["texture"] is None else textures[d["texture"]]
         sampler = None if texture is None else _sampler_from_file(d["sampler"])
         scene.add(meshes[d["mesh"]], model=d["model"], color=d["color"], blend=d["blend"], cull=d["cull"],
-                  texture=texture, sampler=sampler)
+                  texture=texture, sampler=sampler, alpha_cutoff=d["alpha_cutoff"])
     for message in data["warnings"]:
         warnings.warn(message, UserWarning, stacklevel=2)
     cameras = [_camera_from_file(c) for c in data["cameras"]]

@@ -66,7 +66,8 @@ def with_filter(scene: Scene, filter: Optional[str] = None, max_anisotropy: Opti
                               else max_anisotropy, wrap=old.wrap, border_color=old.border_color,
                               lod_bias=old.lod_bias if lod_bias is None else lod_bias)
         out.add(d.mesh, model=d.model, color=d.color, depth_test=d.depth_test, depth_write=d.depth_write,
-                blend=d.blend, interpolation=d.interpolation, cull=d.cull, texture=texture, sampler=sampler)
+                blend=d.blend, interpolation=d.interpolation, cull=d.cull, texture=texture, sampler=sampler,
+                alpha_cutoff=d.alpha_cutoff)
     return out
 
 

@@ -198,6 +198,33 @@ TEST(SceneFile, GlbLoads) {
     check_gltf_scene(mr::load_scene(write_file("scene.glb", glb_bytes(triangle_buffer()))));
 }
 
+TEST(SceneFile, GltfMaskKeepsVertexColourAlphaAndOpaqueDropsIt) {
+    // The scene's material as MASK: COLOR_0's alpha counts (premultiplied, as for BLEND) and the
+    // draw is alpha-tested, not blended; as OPAQUE the alpha is 1.
+    const std::vector<unsigned char> buffer = triangle_buffer();
+    const std::string json = gltf_json("\"uri\": \"data:application/octet-stream;base64," + base64(buffer) + "\", ",
+                                       buffer.size());
+    const float a = 128.0f / 255.0f;
+    for (const std::string mode : {"MASK", "OPAQUE"}) {
+        std::string text = json;
+        text.replace(text.find("\"BLEND\""), 7, "\"" + mode + "\"");
+        const auto s = mr::load_scene(write_file(mode + ".gltf", text));
+        ASSERT_EQ(s.meshes.size(), 1u);
+        const glm::vec4 c = s.meshes[0]->colors[1];
+        EXPECT_EQ(s.draws[0].state.blend, mr::BlendMode::replace) << mode;
+        if (mode == "MASK") {
+            EXPECT_NEAR(c.g, a, 1e-6);
+            EXPECT_NEAR(c.a, a, 1e-6);
+            EXPECT_EQ(s.draws[0].color, glm::vec4(0.25f, 0.125f, 0.5f, 0.5f));
+            EXPECT_EQ(s.draws[0].state.alpha_cutoff, 0.5f);
+        } else {
+            EXPECT_EQ(c, glm::vec4(0, 1, 0, 1));
+            EXPECT_EQ(s.draws[0].color, glm::vec4(0.5f, 0.25f, 1.0f, 1.0f));
+            EXPECT_FALSE(s.draws[0].state.alpha_cutoff);
+        }
+    }
+}
+
 TEST(SceneFile, GltfCameraAspectRatioFromTheFileWins) {
     std::string json = gltf_json("\"uri\": \"data:application/octet-stream;base64," + base64(triangle_buffer()) + "\", ", 56);
     const std::string from = R"("yfov": 0.8, "znear": 0.1)";
@@ -524,16 +551,44 @@ TEST(SceneFileTextures, GltfLoadsUvsNormalsTextureAndSampler) {
     EXPECT_EQ(d.color, glm::vec4(1.0f));
 }
 
-TEST(SceneFileTextures, GltfBlendMaterialKeepsTextureAlpha) {
+TEST(SceneFileTextures, GltfBlendAndMaskMaterialsKeepTextureAlpha) {
     write_texture_png("tex.png");
     TexturedGltf g;
     g.materials = {R"({"alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}})",
-                   R"({"alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}})"};
+                   R"({"alphaMode": "MASK", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}})",
+                   R"({"alphaMode": "MASK", "alphaCutoff": 0.3, "pbrMetallicRoughness":
+                       {"baseColorFactor": [1, 0.5, 0.25, 0.8], "baseColorTexture": {"index": 0}}})",
+                   R"({"alphaMode": "OPAQUE", "alphaCutoff": 0.3,
+                       "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}})"};
     const auto s = mr::load_scene(g.write("blend.gltf"));
-    ASSERT_EQ(s.draws.size(), 2u);
+    EXPECT_TRUE(s.warnings.empty()) << warnings_text(s);
+    ASSERT_EQ(s.draws.size(), 4u);
     expect_texels(s.draws[0].texture, /*ignore_alpha=*/false);  // premultiplied: (a, a, a, a)
     EXPECT_EQ(s.draws[0].state.blend, mr::BlendMode::over);
-    expect_texels(s.draws[1].texture, /*ignore_alpha=*/true);
+    EXPECT_FALSE(s.draws[0].state.alpha_cutoff);
+    // MASK: the texture's alpha kept for the alpha test (the spec's default cutoff 0.5, else the
+    // file's), replace blending, the factor premultiplied.
+    expect_texels(s.draws[1].texture, /*ignore_alpha=*/false);
+    EXPECT_EQ(s.draws[1].state.blend, mr::BlendMode::replace);
+    EXPECT_EQ(s.draws[1].state.alpha_cutoff, 0.5f);
+    EXPECT_EQ(s.draws[2].state.alpha_cutoff, 0.3f);
+    EXPECT_EQ(s.draws[2].color, glm::vec4(0.8f, 0.4f, 0.2f, 0.8f));
+    // OPAQUE ignores alphaCutoff and the texture's alpha.
+    expect_texels(s.draws[3].texture, /*ignore_alpha=*/true);
+    EXPECT_FALSE(s.draws[3].state.alpha_cutoff);
+    EXPECT_EQ(s.draws[3].color, glm::vec4(1.0f));
+}
+
+TEST(SceneFileTextures, GltfMaskCutoffOutsideZeroToOneWarnsAndUsesOneHalf) {
+    write_texture_png("tex.png");
+    TexturedGltf g;
+    g.materials = {
+        R"({"alphaMode": "MASK", "alphaCutoff": 1.5, "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}})"};
+    const auto s = mr::load_scene(g.write("bad_cutoff.gltf"));
+    ASSERT_EQ(s.draws.size(), 1u);
+    EXPECT_EQ(s.draws[0].state.alpha_cutoff, 0.5f);
+    ASSERT_EQ(s.warnings.size(), 1u) << warnings_text(s);
+    EXPECT_NE(s.warnings[0].find("alphaCutoff"), std::string::npos) << s.warnings[0];
 }
 
 TEST(SceneFileTextures, GltfSamplerEnumsMapToSamplers) {

@@ -5,6 +5,7 @@ import warnings
 
 import numpy as np
 import pytest
+from PIL import Image
 
 import mipraster as mr
 
@@ -204,6 +205,97 @@ def test_map_kd_alpha_counts_only_when_the_material_blends(tmp_path, dissolve):
     alpha = scene.draws[0].texture.level(0)[..., 3]
     np.testing.assert_allclose(alpha, texels[..., 3] if dissolve < 1 else 1.0, atol=1e-6)
     np.testing.assert_allclose(render(scene, 2)[0, 1, 3], 0.2 * dissolve if dissolve < 1 else 1.0, atol=1e-6)
+
+
+# --- map_d alpha masks ------------------------------------------------------------------------
+
+BEHIND = np.float32([0.1, 0.2, 0.3, 1.0])
+# The mask of the quadrants TL, TR / BL, BR: kept, discarded / discarded (0.4 < 0.5), kept.
+MASK = np.float32([[1.0, 0.0], [0.4, 0.8]])
+
+
+def masked_obj(tmp_path, statements):
+    """The textured quad with material `statements` (map_Kd checker.png and maybe a map_d), loaded,
+    then an opaque quad behind it (drawn after it: it shows only where no depth was written)."""
+    mr.write_image(tmp_path / "checker.png", TEXELS)
+    (tmp_path / "m.mtl").write_text(f"newmtl tex\nKd 1 1 1\n{statements}\n")
+    (tmp_path / "s.obj").write_text(obj_text())
+    scene, messages = load_quiet(tmp_path / "s.obj")
+    scene.add(mr.Mesh(QUAD_V - [0, 0, 1], [[0, 1, 2], [0, 2, 3]]), color=BEHIND)
+    return scene, messages
+
+
+def quadrants(color):
+    h, w = color.shape[:2]
+    return np.array([color[h // 4, w // 4], color[h // 4, 3 * w // 4], color[3 * h // 4, w // 4],
+                     color[3 * h // 4, 3 * w // 4]])
+
+
+def expect_masked(color, mask):
+    """TEXELS (opaque) where the mask is at least 0.5, BEHIND elsewhere (a 2x2 render: pixel centres on
+    texel centres, where the default trilinear filter returns the texels)."""
+    for q, (texel, m) in enumerate(zip(TEXELS.reshape(4, 4), mask.reshape(4))):
+        np.testing.assert_allclose(quadrants(color)[q], texel if m >= 0.5 else BEHIND, atol=1e-6,
+                                   err_msg=f"quadrant {q}")
+
+
+@pytest.mark.parametrize("mask_size", [2, 3, 4])
+def test_map_d_grey_mask_alpha_tests_the_texture(tmp_path, mask_size):
+    # A grey mask file (read as data, code / 255), of the texture's size or another: each texel of the
+    # texture takes the mask texel its centre falls in (nearest); the others hold 0.6, which a wrong
+    # pick would show.
+    index = np.floor((np.arange(2) + 0.5) / 2 * mask_size).astype(int)
+    mask = np.full((mask_size, mask_size), 0.6, np.float32)
+    mask[np.ix_(index, index)] = MASK
+    Image.fromarray(np.round(mask * 255).astype(np.uint8), "L").save(tmp_path / "mask.png")
+    scene, messages = masked_obj(tmp_path, "map_Kd checker.png\nmap_d mask.png")
+    assert messages == []
+    d = scene.draws[0]
+    assert d.alpha_cutoff == 0.5 and d.blend == "replace"
+    np.testing.assert_allclose(d.texture.level(0)[..., 3], np.round(MASK * 255) / 255, atol=1e-6)
+    expect_masked(render(scene, 2), MASK)
+
+
+def test_map_d_naming_the_map_kd_file_uses_its_alpha(tmp_path):
+    texels = TEXELS * MASK[..., None]  # premultiplied by the mask
+    mr.write_image(tmp_path / "cutout.png", texels)
+    scene, messages = masked_obj(tmp_path, "map_Kd cutout.png\nmap_d cutout.png")
+    assert messages == [] and scene.draws[0].alpha_cutoff == 0.5
+    color = render(scene, 2)  # (pixel centres on texel centres: the filter returns the texels)
+    for q, m in enumerate(MASK.reshape(4)):
+        if m < 0.5:
+            np.testing.assert_array_equal(quadrants(color)[q], BEHIND)
+        else:  # the straight colour, opaque (8-bit sRGB: within a step of TEXELS)
+            np.testing.assert_allclose(quadrants(color)[q], TEXELS.reshape(4, 4)[q], atol=1e-2)
+
+
+def test_map_d_under_a_dissolve_blends_instead(tmp_path):
+    Image.fromarray(np.round(MASK * 255).astype(np.uint8), "L").save(tmp_path / "mask.png")
+    scene, _ = masked_obj(tmp_path, "d 0.5\nmap_Kd checker.png\nmap_d mask.png")
+    d = scene.draws[0]
+    assert d.alpha_cutoff is None and d.blend == "over"
+    np.testing.assert_allclose(d.texture.level(0)[..., 3], np.round(MASK * 255) / 255, atol=1e-6)
+
+
+@pytest.mark.parametrize("statements, note", [
+    ("map_Kd checker.png\nmap_d missing.png", "missing.png': no such file); drawn without it"),
+    ("map_d mask.png", "map_d without map_Kd is not supported"),
+    ("map_Kd checker.png\nmap_d", "map_d names no file"),
+])
+def test_map_d_that_cannot_be_used_warns_and_draws_without_it(tmp_path, statements, note):
+    Image.fromarray(np.round(MASK * 255).astype(np.uint8), "L").save(tmp_path / "mask.png")
+    scene, messages = masked_obj(tmp_path, statements)
+    assert len(messages) == 1 and note in messages[0] and "material 'tex'" in messages[0], messages
+    assert scene.draws[0].alpha_cutoff is None
+    color = render(scene, 2)
+    assert not np.any(np.all(color == BEHIND, axis=-1))  # no holes
+
+
+def test_map_d_options_that_would_move_the_mask_warn(tmp_path):
+    Image.fromarray(np.round(MASK * 255).astype(np.uint8), "L").save(tmp_path / "mask.png")
+    scene, messages = masked_obj(tmp_path, "map_Kd checker.png\nmap_d -imfchan l -s 2 2 1 mask.png")
+    assert len(messages) == 1 and "map_d option -s is ignored" in messages[0], messages
+    expect_masked(render(scene, 2), MASK)
 
 
 # --- text forms ------------------------------------------------------------------------------

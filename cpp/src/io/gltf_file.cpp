@@ -3,6 +3,7 @@
 // file that includes tinygltf.
 #include "scene_file_readers.hpp"
 
+#include "mipraster/core/constants.hpp"
 #include "mipraster/core/memory_limit.hpp"
 #include "mipraster/io/texture_file.hpp"
 
@@ -339,7 +340,7 @@ struct GltfLoader {
         return mat.name.empty() ? "material " + where : "material '" + mat.name + "' (" + where + ")";
     }
 
-    /// The draw's colour, blending, culling, base colour texture and sampler from its material.
+    /// The draw's colour, blending, alpha test, culling, base colour texture and sampler from its material.
     void apply_material(Draw& draw, const tinygltf::Primitive& prim, int mesh_index, int prim_index) {
         const std::string prim_what =
             "meshes[" + std::to_string(mesh_index) + "].primitives[" + std::to_string(prim_index) + "]";
@@ -357,11 +358,24 @@ struct GltfLoader {
         for (double v : f)
             if (!std::isfinite(v)) fail(path, name + ": baseColorFactor is not finite");
         const bool blend = mat.alphaMode == "BLEND";
-        if (blend) {
+        // MASK: alpha-tested against alphaCutoff (tinygltf gives the spec's default, 0.5, when the
+        // file has none), then drawn opaque with replace blending.
+        const bool mask = mat.alphaMode == "MASK";
+        if (blend || mask) {
             draw.color = glm::vec4(f[0] * f[3], f[1] * f[3], f[2] * f[3], f[3]);
-            draw.state.blend = BlendMode::over;
+            if (blend) draw.state.blend = BlendMode::over;
         } else {
             draw.color = glm::vec4(f[0], f[1], f[2], 1.0);
+        }
+        if (mask) {
+            const double cutoff = mat.alphaCutoff;
+            if (cutoff >= 0.0 && cutoff <= 1.0) {
+                draw.state.alpha_cutoff = static_cast<float>(cutoff);
+            } else {
+                warn_once(name + ": alphaCutoff " + std::to_string(cutoff) + " is not in [0, 1]; using " +
+                          std::to_string(kDefaultAlphaCutoff));
+                draw.state.alpha_cutoff = kDefaultAlphaCutoff;
+            }
         }
         if (!mat.doubleSided) draw.state.cull = CullMode::back;
 
@@ -388,7 +402,7 @@ struct GltfLoader {
                       ") has no source image (only extension images such as KTX2/WebP?); drawn without it");
             return;
         }
-        draw.texture = image_texture(tex.source, name, /*ignore_alpha=*/!blend);
+        draw.texture = image_texture(tex.source, name, /*ignore_alpha=*/!(blend || mask));
         draw.sampler = sampler;
     }
 
@@ -516,9 +530,11 @@ struct GltfLoader {
         size = view.byteLength;
     }
 
-    bool material_blends(int material) const {
-        return material >= 0 && static_cast<std::size_t>(material) < model.materials.size() &&
-               model.materials[material].alphaMode == "BLEND";
+    /// Whether the material's alpha counts: it blends (BLEND) or is alpha-tested (MASK).
+    bool material_uses_alpha(int material) const {
+        if (material < 0 || static_cast<std::size_t>(material) >= model.materials.size()) return false;
+        const std::string& mode = model.materials[material].alphaMode;
+        return mode == "BLEND" || mode == "MASK";
     }
 
     /// The primitive's vertices in drawing order: its indices (any unsigned component type, each
@@ -646,8 +662,8 @@ struct GltfLoader {
         for (std::size_t i = 0; i < pos.count(); ++i)
             mesh->positions[i] = glm::vec3(pos.get(i, 0), pos.get(i, 1), pos.get(i, 2));
 
-        // Vertex colours (linear); premultiplied by their alpha when the material blends,
-        // opaque otherwise (alpha is ignored for OPAQUE/MASK materials).
+        // Vertex colours (linear); premultiplied by their alpha when the material blends or masks,
+        // opaque otherwise (alpha is ignored for OPAQUE materials).
         if (const auto col_it = prim.attributes.find("COLOR_0"); col_it != prim.attributes.end()) {
             const AccessorReader col(model, col_it->second, path, what + " COLOR_0");
             if (col.components() != 3 && col.components() != 4)
@@ -660,10 +676,10 @@ struct GltfLoader {
             if (col.count() != pos.count())
                 fail(path, col.what() + ": COLOR_0 has " + std::to_string(col.count()) + " elements, POSITION " +
                                std::to_string(pos.count()));
-            const bool blend = material_blends(prim.material);
+            const bool alpha = material_uses_alpha(prim.material);
             mesh->colors.resize(col.count());
             for (std::size_t i = 0; i < col.count(); ++i) {
-                const double a = col.components() == 4 && blend ? col.get(i, 3) : 1.0;
+                const double a = col.components() == 4 && alpha ? col.get(i, 3) : 1.0;
                 mesh->colors[i] = glm::vec4(col.get(i, 0) * a, col.get(i, 1) * a, col.get(i, 2) * a, a);
             }
         }

@@ -3,6 +3,8 @@
 // tinyobjloader.
 #include "scene_file_readers.hpp"
 
+#include "mipraster/core/constants.hpp"
+#include "mipraster/io/image_io.hpp"
 #include "mipraster/io/texture_file.hpp"
 
 #include <algorithm>
@@ -414,6 +416,7 @@ struct ObjMaterial {
     double d = 1.0, tr = 0.0;    ///< d (dissolve) and Tr (transparency, 1 − d) as given
     bool has_d = false, has_tr = false;
     std::string map_kd;                          ///< the map_Kd file as written; empty: none
+    std::string map_d;                           ///< the map_d file (an alpha mask) as written; empty: none
     glm::vec2 uv_scale{1.0f}, uv_offset{0.0f};   ///< map_Kd -s and -o (u and v)
     bool clamp = false, linear = false;          ///< map_Kd -clamp on, -colorspace linear
 
@@ -421,13 +424,16 @@ struct ObjMaterial {
     double dissolve() const { return has_d ? d : has_tr ? 1.0 - tr : 1.0; }
 };
 
-/// Parses "map_Kd [options] file". Options this renderer applies: -s and -o (u, v; w ignored),
-/// -clamp and -colorspace. Those that change the look but are not applied (-mm, -t, -cc on) are
-/// warned about; those without meaning for a colour map here (-bm, -blendu, -blendv, -boost,
-/// -texres, -imfchan, -type) are skipped quietly. The file name is the rest of the line (names
+/// An option of a texture map statement: its name, its numbers or its word (lower case).
+using MapOption = std::function<void(std::string_view option, const std::vector<double>& numbers,
+                                     const std::string& word)>;
+
+/// Parses "<keyword> [options] file" (map_Kd, map_d): each option, with its arguments, goes to
+/// `apply` (an unknown one is warned about); returns the file name, the rest of the line (names
 /// may hold spaces).
-void parse_map_kd(std::string_view rest, ObjMaterial& m, const std::function<void(const std::string&)>& bad,
-                  const std::function<void(const std::string&)>& warn) {
+std::string parse_map_statement(std::string_view rest, const std::string& keyword,
+                                const std::function<void(const std::string&)>& bad,
+                                const std::function<void(const std::string&)>& warn, const MapOption& apply) {
     // Option name → (minimum, maximum) number of arguments; numbers unless the option is an on/off or a word.
     static const std::map<std::string_view, std::pair<int, int>> kOptions = {
         {"-blendu", {1, 1}}, {"-blendv", {1, 1}}, {"-cc", {1, 1}},    {"-clamp", {1, 1}}, {"-bm", {1, 1}},
@@ -451,15 +457,28 @@ void parse_map_kd(std::string_view rest, ObjMaterial& m, const std::function<voi
             double value = 0.0;
             for (std::string_view probe = after; static_cast<int>(numbers.size()) < most && more();) {
                 if (!parse_number(next_word(probe), value)) break;
-                if (!std::isfinite(value)) bad("map_Kd " + std::string(option) + " values must be finite");
+                if (!std::isfinite(value)) bad(keyword + " " + std::string(option) + " values must be finite");
                 numbers.push_back(value);
                 after = probe;
             }
         }
         rest = trim_blanks(after);
-        if (known == kOptions.end()) {
-            warn("map_Kd option '" + std::string(option) + "' is unknown; ignored");
-        } else if (option == "-s" || option == "-o") {
+        if (known == kOptions.end()) warn(keyword + " option '" + std::string(option) + "' is unknown; ignored");
+        else apply(option, numbers, word);
+    }
+    return std::string(rest);
+}
+
+/// Parses "map_Kd [options] file". Options this renderer applies: -s and -o (u, v; w ignored),
+/// -clamp and -colorspace. Those that change the look but are not applied (-mm, -t, -cc on) are
+/// warned about; those without meaning for a colour map here (-bm, -blendu, -blendv, -boost,
+/// -texres, -imfchan, -type) are skipped quietly.
+void parse_map_kd(std::string_view rest, ObjMaterial& m, const std::function<void(const std::string&)>& bad,
+                  const std::function<void(const std::string&)>& warn) {
+    m.map_kd = parse_map_statement(rest, "map_Kd", bad, warn, [&](std::string_view option,
+                                                                  const std::vector<double>& numbers,
+                                                                  const std::string& word) {
+        if (option == "-s" || option == "-o") {
             glm::vec2& v = option == "-s" ? m.uv_scale : m.uv_offset;
             for (std::size_t i = 0; i < numbers.size() && i < 2; ++i)
                 v[static_cast<int>(i)] = static_cast<float>(numbers[i]);
@@ -473,9 +492,23 @@ void parse_map_kd(std::string_view rest, ObjMaterial& m, const std::function<voi
                    (option == "-cc" && word == "on")) {
             warn("map_Kd option " + std::string(option) + " is not supported; the texture is drawn without it");
         }
-    }
-    m.map_kd = std::string(rest);
+    });
     if (m.map_kd.empty()) warn("map_Kd names no file; drawn without a texture");
+}
+
+/// Parses "map_d [options] file": the mask is read at map_Kd's uvs (its -s, -o and -clamp), so
+/// options that would move it apart (-s, -o, -clamp, -mm, -t, -cc) are warned about and ignored;
+/// -imfchan, -texres, -boost, -bm, -blendu/v, -type and -colorspace are skipped quietly (the mask is the
+/// file's alpha, or its first channel when it has no alpha).
+void parse_map_d(std::string_view rest, ObjMaterial& m, const std::function<void(const std::string&)>& bad,
+                 const std::function<void(const std::string&)>& warn) {
+    m.map_d = parse_map_statement(rest, "map_d", bad, warn, [&](std::string_view option, const std::vector<double>&,
+                                                                const std::string&) {
+        if (option == "-s" || option == "-o" || option == "-clamp" || option == "-mm" || option == "-t" ||
+            option == "-cc")
+            warn("map_d option " + std::string(option) + " is ignored; the mask is read at map_Kd's uvs");
+    });
+    if (m.map_d.empty()) warn("map_d names no file; drawn without an alpha mask");
 }
 
 /// The materials of an MTL file (its own reader: tinyobjloader's takes a missing Kd as black, or
@@ -539,7 +572,7 @@ void read_mtl(const std::string& path, std::vector<ObjMaterial>& materials, std:
         } else if (keyword == "map_Kd") {
             parse_map_kd(rest, *m, bad, warn);
         } else if (keyword == "map_d") {
-            warn("map_d (an alpha mask) is not supported; drawn with the constant dissolve");
+            parse_map_d(rest, *m, bad, warn);
         }
     });
 }
@@ -569,6 +602,9 @@ std::vector<ObjMaterial> read_materials(const std::string& obj_path, const ObjSo
         if (m.dissolve() == 0.0)
             warnings.push_back(where + "fully transparent (" + (m.has_d ? "d 0" : "Tr 1") +
                                "); its faces are invisible");
+        // The mask is read at map_Kd's uvs, into map_Kd's texture (map_kd_texture).
+        if (!m.map_d.empty() && m.map_kd.empty())
+            warnings.push_back(where + "map_d without map_Kd is not supported; drawn without the alpha mask");
         materials.push_back(std::move(m));
     }
     return materials;
@@ -646,33 +682,86 @@ std::vector<std::array<std::size_t, 3>> triangulate(const std::vector<glm::dvec3
 
 // --- the loader --------------------------------------------------------------------------------
 
-/// The texture of a material's map_Kd: the file relative to its MTL file's folder (as MTL files
-/// mean it), else the OBJ's (see locate), decoded as sRGB unless -colorspace linear, its alpha
-/// used only when the material blends (d < 1), as glTF does for alphaMode BLEND; a file found
-/// elsewhere than written is used with a warning, and a missing or unreadable one becomes the
-/// error texture with a warning.
-Texture map_kd_texture(const std::string& obj_path, const ObjMaterial& m, std::vector<std::string>& warnings) {
-    const std::string where = m.mtl_path + ": material '" + m.name + "': ";
+/// Where the map file `written` (map_Kd or map_d, `keyword`) of material m is: relative to its MTL
+/// file's folder (as MTL files mean it), else the OBJ's (see locate); a file found elsewhere than
+/// written comes with a warning; the path as written when there is none (loading it then fails).
+std::string locate_map(const std::string& obj_path, const ObjMaterial& m, const std::string& written,
+                       const char* keyword, std::vector<std::string>& warnings) {
     std::vector<std::string> dirs = {directory_of(m.mtl_path)};
     if (directory_of(obj_path) != dirs[0]) dirs.push_back(directory_of(obj_path));
-    std::string file = locate(m.map_kd, dirs);
-    std::string as_written = m.map_kd;
+    std::string file = locate(written, dirs);
+    std::string as_written = written;
     std::replace(as_written.begin(), as_written.end(), '\\', '/');
     if (!is_drive_path(as_written) && (as_written.empty() || as_written[0] != '/')) as_written = dirs[0] + as_written;
-    if (file.empty()) {
-        file = as_written;
-    } else if (std::filesystem::path(file).lexically_normal() != std::filesystem::path(as_written).lexically_normal()) {
-        warnings.push_back(where + "map_Kd '" + m.map_kd + "' is not at '" + as_written + "'; using '" + file + "'");
+    if (file.empty()) return as_written;
+    if (std::filesystem::path(file).lexically_normal() != std::filesystem::path(as_written).lexically_normal())
+        warnings.push_back(m.mtl_path + ": material '" + m.name + "': " + keyword + " '" + written + "' is not at '" +
+                           as_written + "'; using '" + file + "'");
+    return file;
+}
+
+/// A material's texture, and whether its alpha is a map_d mask.
+struct MaterialTexture {
+    Texture texture;
+    bool masked = false;
+};
+
+/// map_Kd's colour with map_d's mask as alpha: the mask image's alpha where it has one (some value
+/// below 1), else its first channel (a grey mask), read as data (code / max code); a mask of
+/// another size is read at the nearest texel.
+Texture masked_texture(const Image& colour, const Image& mask, const std::string& name) {
+    bool mask_alpha = false;
+    for (std::size_t i = 3; i < mask.pixels.size() && !mask_alpha; i += 4) mask_alpha = mask.pixels[i] < 1.0f;
+    std::vector<float> texels(static_cast<std::size_t>(colour.width) * static_cast<std::size_t>(colour.height) * 4);
+    for (int y = 0; y < colour.height; ++y) {
+        const int my = static_cast<int>((std::int64_t{2} * y + 1) * mask.height / (std::int64_t{2} * colour.height));
+        for (int x = 0; x < colour.width; ++x) {
+            const int mx = static_cast<int>((std::int64_t{2} * x + 1) * mask.width / (std::int64_t{2} * colour.width));
+            const float a = mask.at(mx, my, mask_alpha ? 3 : 0);
+            float* t = &texels[(static_cast<std::size_t>(y) * static_cast<std::size_t>(colour.width) + x) * 4];
+            for (int c = 0; c < 3; ++c) t[c] = colour.at(x, y, c) * a;
+            t[3] = a;
+        }
     }
+    return Texture::from_float(texels.data(), colour.width, colour.height, 4, /*premultiplied=*/true, name);
+}
+
+/// The texture of a material's map_Kd (located by locate_map), decoded as sRGB unless
+/// -colorspace linear, its alpha used only when the material blends (d < 1), as glTF does for
+/// alphaMode BLEND; a missing or unreadable file becomes the error texture with a warning. With a
+/// map_d (an alpha mask), the texture's alpha is the mask instead: map_Kd's own alpha when map_d
+/// names the same file, else masked_texture; a mask that cannot be read is a warning, and the
+/// material is drawn without it.
+MaterialTexture map_kd_texture(const std::string& obj_path, const ObjMaterial& m, std::vector<std::string>& warnings) {
+    const std::string where = m.mtl_path + ": material '" + m.name + "': ";
+    const std::string file = locate_map(obj_path, m, m.map_kd, "map_Kd", warnings);
+    const std::string mask_file = m.map_d.empty() ? "" : locate_map(obj_path, m, m.map_d, "map_d", warnings);
+    const bool own_alpha = !mask_file.empty() && std::filesystem::path(mask_file).lexically_normal() ==
+                                                     std::filesystem::path(file).lexically_normal();
     TextureFileOptions options;
-    options.ignore_alpha = m.dissolve() >= 1.0;
+    options.ignore_alpha = m.dissolve() >= 1.0 && !own_alpha;
     options.srgb = !m.linear;
+    Texture texture;
     try {
-        return load_texture(file, options);
+        texture = load_texture(file, options);
     } catch (const std::exception& e) {  // missing, unreadable, corrupt or too large
         warnings.push_back(where + "cannot load its map_Kd texture '" + file + "' (" + e.what() +
                            "); drawing the error texture instead");
-        return error_texture();
+        return {error_texture(), false};
+    }
+    if (mask_file.empty() || own_alpha) return {texture, own_alpha};
+    try {
+        ImageReadOptions colour_options, mask_options;
+        colour_options.srgb = !m.linear;
+        colour_options.ignore_alpha = true;  // (the mask replaces it)
+        mask_options.srgb = false;
+        return {masked_texture(read_image(file, colour_options), read_image(mask_file, mask_options),
+                               file + " (map_d " + mask_file + ")"),
+                true};
+    } catch (const std::exception& e) {
+        warnings.push_back(where + "cannot load its map_d mask '" + mask_file + "' (" + e.what() +
+                           "); drawn without it");
+        return {texture, false};
     }
 }
 
@@ -784,7 +873,7 @@ LoadedScene load_obj(const std::string& path) {
 
     // Step 2: one compact mesh and draw per group; vertices are split by their (position,
     // texture coordinate, normal) indices, those the group keeps.
-    std::map<int, Texture> textures;  // by material
+    std::map<int, MaterialTexture> textures;  // by material
     for (ObjGroup& g : groups) {
         const std::string name = material_name(g.material);
         const bool keep_uvs = g.all_uvs && (g.textured || !is_textured(g.material));
@@ -850,7 +939,10 @@ LoadedScene load_obj(const std::string& path) {
             auto it = textures.find(g.material);
             if (it == textures.end())
                 it = textures.emplace(g.material, map_kd_texture(path, materials[g.material], scene.warnings)).first;
-            draw.texture = it->second;
+            draw.texture = it->second.texture;
+            // A map_d mask: alpha-tested as glTF's MASK, or, under a dissolve, blended with it.
+            if (it->second.masked && draw.state.blend == BlendMode::replace)
+                draw.state.alpha_cutoff = kDefaultAlphaCutoff;
             if (materials[g.material].clamp) draw.sampler.wrap_u = draw.sampler.wrap_v = WrapMode::clamp;
         }
         scene.meshes.push_back(std::move(mesh));

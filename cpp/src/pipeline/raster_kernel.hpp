@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "mipraster/core/constants.hpp"
+#include "mipraster/pipeline/alpha_test.hpp"
 #include "mipraster/pipeline/blend.hpp"
 #include "mipraster/pipeline/interpolate.hpp"
 #include "mipraster/pipeline/rasterize_tile.hpp"
@@ -75,10 +76,12 @@ void shade_row_colours(float* target, int stride, std::uint32_t passed, const do
     }
 }
 
-// True when a draw's texture lookups go through a lookup queue (debug views never do).
+// True when a draw's texture lookups go through a lookup queue (debug views never do, nor
+// alpha-tested draws: the queue shades after the depth writes).
 template <Texturing kTexturing>
 inline bool queues_lookups(const DrawInputs& draw) {
-    return kTexturing != Texturing::none && draw.batched_lookups && draw.debug_view == DebugView::none;
+    return kTexturing != Texturing::none && draw.batched_lookups && draw.debug_view == DebugView::none &&
+           !draw.alpha_cutoff;
 }
 
 template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode, Texturing kTexturing>
@@ -93,6 +96,11 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     // Coverage masks four samples per vector (pixel_coverage_avx2; also MSAA's depth tests,
     // pixel_vectors below).
     const bool vector_masks = target.sample_rows && S % 4 == 0 && BatchSampler::widest_vector() == 8;
+    // An alpha-tested draw (DrawInputs::alpha_cutoff) writes a sample's depth only once its shade
+    // survives the test: only the per-sample paths below, which test depth, shade, then write, take
+    // it (the sample rows and MSAA's pixel vectors store depths as they test them). Deferred
+    // shading's pre-pass never sees one.
+    const bool alpha_tested = kShading != Shading::visibility && draw.alpha_cutoff.has_value();
     std::optional<LookupQueue<kBlend, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
 
@@ -163,7 +171,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         // 12 % slower when every pixel took the vectors).
         const std::uint64_t all_samples = S == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << S) - 1;
         double offset0[kMaxSamples], offset1[kMaxSamples], offset2[kMaxSamples];
-        const bool pixel_vectors = kMode == SampleMode::msaa && kDepth != DepthFunc::none && vector_masks;
+        const bool pixel_vectors =
+            kMode == SampleMode::msaa && kDepth != DepthFunc::none && vector_masks && !alpha_tested;
         if (pixel_vectors)
             for (int s = 0; s < S; ++s)
                 offset0[s] = static_cast<double>(off0[s]), offset1[s] = static_cast<double>(off1[s]),
@@ -188,6 +197,27 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_out.at(px, py, s),
                                                          std::uint64_t{1}, draw, colors, uvs, t, l, batch.clip_weights,
                                                          px, py);
+            }
+        };
+        // An alpha-tested draw's samples `samples` of pixel (px, py) that passed the depth test, shaded
+        // once at screen weights l: discarded, or their colour written and (depth_write) their depths
+        // z[s] into depth_px (null without a depth test).
+        const auto alpha_tested_samples = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l,
+                                              const float* z, float* depth_px) {
+            if constexpr (kShading != Shading::visibility) {
+                counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples));
+                ++counters.shader_invocations;
+                glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, l, batch.clip_weights, px, py);
+                if (!alpha_test(c, *draw.alpha_cutoff)) return;
+                float* const color_px = color_out.at(px, py, 0);
+                for (std::uint64_t m = samples; m; m &= m - 1) {
+                    const int s = __builtin_ctzll(m);
+                    if constexpr (kDepth != DepthFunc::none) {
+                        if (draw.depth_write) depth_px[s] = z[s];
+                    }
+                    blend_into<kBlend>(color_px + 4 * s, c);
+                }
+                if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
             }
         };
 
@@ -269,7 +299,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             // time, sample by sample (sample_row.hpp). With several samples, only where none of
             // their rows can be refused; one sample's refused row takes the per-sample path.
             if constexpr (kMode != SampleMode::msaa && kDepth != DepthFunc::none) {
-                bool rows = target.sample_rows && n >= kSampleRowMinPixels &&
+                bool rows = target.sample_rows && !alpha_tested && n >= kSampleRowMinPixels &&
                             (kMode == SampleMode::single || sample_rows_exact(t, {row0, row1, row2}, n));
                 if (rows) {
                     const std::uint32_t skipped = blocks.row_pixels(cls.skipped, py, rx0, n);
@@ -360,6 +390,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     // Depth per sample, colour once per pixel: at the pixel centre when it is inside the
                     // triangle, else at the first covered sample that passed (never extrapolated).
                     std::uint64_t passed = 0;
+                    float z_of[kMaxSamples];  // alpha-tested: the passed samples' depths, written after the shade
                     if (pixel_vectors && covered == all_samples &&
                         test_pixel_samples_avx2(t, {p1, p2, offset1, offset2, S}, covered, kDepth, draw.depth_write,
                                                 depth_px, passed)) {
@@ -372,14 +403,17 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         if constexpr (kDepth != DepthFunc::none) {
                             const float z = sample_depth(t, screen_weights(t, p0 + off0[s], p1 + off1[s], p2 + off2[s]));
                             if (!depth_passes<kDepth>(z, depth_px[s])) continue;
-                            if (draw.depth_write) depth_px[s] = z;
+                            if (alpha_tested) z_of[s] = z;
+                            else if (draw.depth_write) depth_px[s] = z;
                         }
                         passed |= std::uint64_t{1} << s;
                     }
                     if (!passed) continue;
-                    if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
-                    counters.samples_passed += static_cast<std::uint64_t>(count_bits(passed));
-                    ++counters.shader_invocations;
+                    if (!alpha_tested) {
+                        if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
+                        counters.samples_passed += static_cast<std::uint64_t>(count_bits(passed));
+                        ++counters.shader_invocations;
+                    }
                     glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
                     if constexpr (!((kShading == Shading::constant || kShading == Shading::flat) &&
                                     kTexturing == Texturing::none)) {
@@ -391,6 +425,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             c2 = p2 + off2[s];
                         }
                         l = screen_weights(t, c0, c1, c2);
+                    }
+                    if (alpha_tested) {
+                        alpha_tested_samples(px, py, passed, l, z_of, depth_px);
+                        continue;
                     }
                     shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px, passed, draw, colors, uvs,
                                                              t, l, batch.clip_weights, px, py);
@@ -408,7 +446,16 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         if constexpr (kDepth != DepthFunc::none) {
                             const float z = sample_depth(t, l);
                             if (!depth_passes<kDepth>(z, depth_px[s])) continue;
+                            if (alpha_tested) {
+                                float z_of[kMaxSamples];
+                                z_of[s] = z;
+                                alpha_tested_samples(px, py, std::uint64_t{1} << s, l, z_of, depth_px);
+                                continue;
+                            }
                             if (draw.depth_write) depth_px[s] = z;
+                        } else if (alpha_tested) {
+                            alpha_tested_samples(px, py, std::uint64_t{1} << s, l, nullptr, nullptr);
+                            continue;
                         }
                         passed_sample(px, py, s, l);
                     }

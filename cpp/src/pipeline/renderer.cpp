@@ -99,6 +99,7 @@ void validate_draws(const std::vector<Draw>& draws) {
                                             "') but its mesh has no uvs");
             draws[i].sampler.validate();
         }
+        draws[i].state.validate(name + ".state");
     }
 }
 
@@ -508,10 +509,12 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         prepass.shading = Shading::visibility;
         prepass_kernels[d] = select_tile_kernel(prepass);
         shading_kernels[d] = select_owned_shading_kernel(key);
-        deferred = deferred && shading_kernels[d];
+        // An alpha-tested draw's samples keep the depth of what lies behind wherever its shade is
+        // discarded: the pre-pass, which shades nothing, cannot know which triangle a sample ends up with.
+        deferred = deferred && shading_kernels[d] && !draws[d].state.alpha_cutoff;
         const Mesh& mesh = *draws[d].mesh;
         inputs[d] = {mesh.triangles.data(), mesh.has_colors() ? mesh.colors.data() : nullptr, draws[d].color,
-                     draws[d].state.depth_write};
+                     draws[d].state.depth_write, draws[d].state.alpha_cutoff};
         if (draws[d].texture) {
             textures[d] = std::make_unique<TextureView>(draws[d].texture);
             inputs[d].uvs = mesh.uvs.data();

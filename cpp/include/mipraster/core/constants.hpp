@@ -78,6 +78,12 @@ static_assert(kWideCrossingRatio * 0x1p-53 * kMaxDimension <= 0x1p-12, "crossing
 /// an EWA ellipse's taps (at most 256² of weight ≤ 1) and a line of up to 1,024 anisotropic probes
 /// summed as differences from the first (each ≤ 2 of the bound). Far beyond any real radiance.
 inline constexpr float kMaxTexelMagnitude = 1e32f;
+
+/// The alpha test's cutoff of scene files that give none: glTF's default alphaCutoff (also for a
+/// glTF cutoff outside [0, 1]) and OBJ materials with a map_d alpha mask (MTL has no cutoff).
+/// Halfway: a mask filtered across its edge keeps the edge where it was.
+inline constexpr float kDefaultAlphaCutoff = 0.5f;
+static_assert(kDefaultAlphaCutoff > 0.0f && kDefaultAlphaCutoff < 1.0f, "a cutoff that keeps and discards");
 static_assert(double(kMaxTexelMagnitude) * 2.0 * 65536.0 < 3.4e38, "the filters' largest sums stay within float");
 
 /// A triangle about to be clipped counts as projecting to a line when its homogeneous 3×3

@@ -48,7 +48,7 @@ struct ImageReadOptions {
     /// data read as code / max code. Float files are linear whatever this says.
     bool srgb = true;
     /// Drop the alpha channel: every pixel gets alpha 1 and keeps its straight (un-premultiplied)
-    /// colour, for materials that ignore texture alpha (glTF OPAQUE/MASK, OBJ).
+    /// colour, for materials that ignore texture alpha (glTF OPAQUE, opaque OBJ materials).
     bool ignore_alpha = false;
 };
 

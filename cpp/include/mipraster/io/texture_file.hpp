@@ -15,7 +15,7 @@ struct TextureFileOptions {
     /// data (code / max code). Float files (EXR, HDR) are linear either way.
     bool srgb = true;
     /// Ignore the file's alpha: alpha 1 with the straight colour (for materials that are opaque
-    /// whatever their texture's alpha says: glTF OPAQUE and MASK, OBJ).
+    /// whatever their texture's alpha says: glTF OPAQUE, opaque OBJ materials).
     bool ignore_alpha = false;
 
     std::string to_string() const;

@@ -1,6 +1,7 @@
 #pragma once
 // A draw: a mesh, its model matrix, its material (constant colour, optional base-colour texture and
 // sampler) and the fixed-function state it uses.
+#include <optional>
 #include <string>
 
 #include <glm/mat4x4.hpp>
@@ -40,7 +41,15 @@ struct DrawState {
     BlendMode blend = BlendMode::replace;
     Interpolation interpolation = Interpolation::perspective;
     CullMode cull = CullMode::none;
+    /// Alpha testing (glTF alphaMode MASK); none (the default): off. A fragment whose shaded alpha
+    /// (draw colour × vertex colour × filtered texture, premultiplied) is below the cutoff, or NaN,
+    /// is discarded: it writes neither colour nor depth. One at or above it is written opaque: rgb
+    /// divided by its alpha (kept as it is at alpha 0, which only a cutoff of 0 lets through),
+    /// alpha 1, then blended as `blend` says. A number in [0, 1].
+    std::optional<float> alpha_cutoff;
 
+    /// Throws std::invalid_argument naming `name`.alpha_cutoff when it is NaN or outside [0, 1].
+    void validate(const std::string& name) const;
     std::string to_string() const;
 };
 

@@ -1,0 +1,18 @@
+#pragma once
+// Alpha test stage (glTF alphaMode MASK, DrawState::alpha_cutoff): a shaded fragment is either
+// discarded or made opaque, before any depth or colour is written.
+#include <glm/vec4.hpp>
+
+namespace mipraster {
+
+/// False when premultiplied colour c's alpha is below `cutoff` or NaN (the fragment is discarded);
+/// else true with c made opaque: rgb / alpha and alpha 1 (rgb kept at alpha 0, which only a cutoff
+/// of 0 lets through: there is no colour to divide out).
+inline bool alpha_test(glm::vec4& c, float cutoff) {
+    if (!(c.a >= cutoff)) return false;
+    if (c.a > 0.0f) c = glm::vec4(c.r / c.a, c.g / c.a, c.b / c.a, 1.0f);
+    else c.a = 1.0f;
+    return true;
+}
+
+}  // namespace mipraster
