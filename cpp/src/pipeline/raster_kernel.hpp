@@ -84,6 +84,84 @@ inline bool queues_lookups(const DrawInputs& draw) {
            !draw.alpha_cutoff;
 }
 
+// Triangle t of an alpha-tested draw (DrawInputs::alpha_cutoff) over pixels [x0, x1) × [y0, y1) of
+// the tile: each covered sample depth-tested, shaded (MSAA once per pixel, at its centre when that
+// is inside the triangle, else at its first sample that passed; else each sample), alpha-tested,
+// and only then its depth and colour written. Every other path writes depth as it tests it; a
+// branch for alpha testing inside their loops cost the other draws 3–5 % of the kernel's
+// instructions (many_small MSAA 4x), so alpha-tested triangles take this one, sample by sample.
+template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode, Texturing kTexturing>
+[[gnu::noinline]] void alpha_tested_triangle(const TileTarget& target, const DrawInputs& draw, const SetupTriangle& t,
+                                             const ClipWeights* clip_weights, int x0, int y0, int x1, int y1,
+                                             TileBlocks& blocks, TileCounters& counters) {
+    const SamplePattern& pattern = *target.pattern;
+    const int S = kMode == SampleMode::single ? 1 : pattern.count();
+    constexpr std::int64_t kStep = kSubpixelOne;
+    const glm::uvec3 tri = draw.triangles[t.triangle];
+    VertexValues colors{};
+    if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective)
+        colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
+    TriangleUvs uvs;
+    if constexpr (kTexturing != Texturing::none) uvs = TriangleUvs(t, tri, draw.uvs, clip_weights);
+    std::int64_t off[3][kMaxSamples];  // edge offsets of each sample from its pixel's corner
+    for (int s = 0; s < S; ++s)
+        for (int i = 0; i < 3; ++i)
+            off[i][s] = std::int64_t{t.edge_a[i]} * pattern.x[s] + std::int64_t{t.edge_b[i]} * pattern.y[s];
+
+    // Shades samples `samples` of pixel (px, py) at screen weights l: discarded, or their colour
+    // written and (depth_write) their depths z[s].
+    const auto shade_test_write = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l, const float* z) {
+        counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples));
+        ++counters.shader_invocations;
+        glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, l, clip_weights, px, py);
+        if (!alpha_test(c, *draw.alpha_cutoff)) return;
+        float* const color_px = target.color.at(px, py, 0);
+        for (std::uint64_t m = samples; m; m &= m - 1) {
+            const int s = __builtin_ctzll(m);
+            if constexpr (kDepth != DepthFunc::none)
+                if (draw.depth_write) target.depth.at(px, py, 0)[s] = z[s];
+            blend_into<kBlend>(color_px + 4 * s, c);
+        }
+        if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
+    };
+    for (int py = y0; py < y1; ++py) {
+        for (int px = x0; px < x1; ++px) {
+            const std::int64_t X = std::int64_t{px} * kStep, Y = std::int64_t{py} * kStep;
+            std::int64_t p[3];
+            for (int i = 0; i < 3; ++i) p[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+            float z[kMaxSamples];
+            std::uint64_t passed = 0;
+            for (int s = 0; s < S; ++s) {
+                const std::int64_t e0 = p[0] + off[0][s], e1 = p[1] + off[1][s], e2 = p[2] + off[2][s];
+                if ((e0 | e1 | e2) < 0) continue;
+                ++counters.samples_covered;
+                if constexpr (kDepth != DepthFunc::none) {
+                    z[s] = sample_depth(t, screen_weights(t, e0, e1, e2));
+                    if (!depth_passes<kDepth>(z[s], target.depth.at(px, py, 0)[s])) continue;
+                }
+                passed |= std::uint64_t{1} << s;
+            }
+            if (!passed) continue;
+            const auto weights_at = [&](int s) {
+                return screen_weights(t, p[0] + off[0][s], p[1] + off[1][s], p[2] + off[2][s]);
+            };
+            if constexpr (kMode == SampleMode::msaa) {
+                const std::int64_t c0 = p[0] + (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * (kStep / 2);
+                const std::int64_t c1 = p[1] + (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * (kStep / 2);
+                const std::int64_t c2 = p[2] + (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * (kStep / 2);
+                const glm::dvec3 l =
+                    (c0 | c1 | c2) >= 0 ? screen_weights(t, c0, c1, c2) : weights_at(__builtin_ctzll(passed));
+                shade_test_write(px, py, passed, l, z);
+            } else {
+                for (std::uint64_t m = passed; m; m &= m - 1) {
+                    const int s = __builtin_ctzll(m);
+                    shade_test_write(px, py, std::uint64_t{1} << s, weights_at(s), z);
+                }
+            }
+        }
+    }
+}
+
 template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode, Texturing kTexturing>
 void raster_tile(const TileTarget& target, const DrawInputs& draw, const TriangleBatch& batch,
                  TileCounters& counters) {
@@ -96,11 +174,6 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     // Coverage masks four samples per vector (pixel_coverage_avx2; also MSAA's depth tests,
     // pixel_vectors below).
     const bool vector_masks = target.sample_rows && S % 4 == 0 && BatchSampler::widest_vector() == 8;
-    // An alpha-tested draw (DrawInputs::alpha_cutoff) writes a sample's depth only once its shade
-    // survives the test: only the per-sample paths below, which test depth, shade, then write, take
-    // it (the sample rows and MSAA's pixel vectors store depths as they test them). Deferred
-    // shading's pre-pass never sees one.
-    const bool alpha_tested = kShading != Shading::visibility && draw.alpha_cutoff.has_value();
     std::optional<LookupQueue<kBlend, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
 
@@ -116,6 +189,13 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
         const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
         if (x0 >= x1 || y0 >= y1) continue;
+        if constexpr (kShading != Shading::visibility) {  // (deferred shading never takes alpha-tested draws)
+            if (draw.alpha_cutoff) {
+                alpha_tested_triangle<kDepth, kBlend, kShading, kMode, kTexturing>(target, draw, t, batch.clip_weights,
+                                                                                   x0, y0, x1, y1, blocks, counters);
+                continue;
+            }
+        }
         // Blocks with nothing to do, and blocks whose depth tests would all fail (tile_blocks.hpp).
         BlockClasses cls;
         if (target.block_skipping) {
@@ -171,8 +251,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         // 12 % slower when every pixel took the vectors).
         const std::uint64_t all_samples = S == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << S) - 1;
         double offset0[kMaxSamples], offset1[kMaxSamples], offset2[kMaxSamples];
-        const bool pixel_vectors =
-            kMode == SampleMode::msaa && kDepth != DepthFunc::none && vector_masks && !alpha_tested;
+        const bool pixel_vectors = kMode == SampleMode::msaa && kDepth != DepthFunc::none && vector_masks;
         if (pixel_vectors)
             for (int s = 0; s < S; ++s)
                 offset0[s] = static_cast<double>(off0[s]), offset1[s] = static_cast<double>(off1[s]),
@@ -197,27 +276,6 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_out.at(px, py, s),
                                                          std::uint64_t{1}, draw, colors, uvs, t, l, batch.clip_weights,
                                                          px, py);
-            }
-        };
-        // An alpha-tested draw's samples `samples` of pixel (px, py) that passed the depth test, shaded
-        // once at screen weights l: discarded, or their colour written and (depth_write) their depths
-        // z[s] into depth_px (null without a depth test).
-        const auto alpha_tested_samples = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l,
-                                              const float* z, float* depth_px) {
-            if constexpr (kShading != Shading::visibility) {
-                counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples));
-                ++counters.shader_invocations;
-                glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, l, batch.clip_weights, px, py);
-                if (!alpha_test(c, *draw.alpha_cutoff)) return;
-                float* const color_px = color_out.at(px, py, 0);
-                for (std::uint64_t m = samples; m; m &= m - 1) {
-                    const int s = __builtin_ctzll(m);
-                    if constexpr (kDepth != DepthFunc::none) {
-                        if (draw.depth_write) depth_px[s] = z[s];
-                    }
-                    blend_into<kBlend>(color_px + 4 * s, c);
-                }
-                if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
             }
         };
 
@@ -299,7 +357,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             // time, sample by sample (sample_row.hpp). With several samples, only where none of
             // their rows can be refused; one sample's refused row takes the per-sample path.
             if constexpr (kMode != SampleMode::msaa && kDepth != DepthFunc::none) {
-                bool rows = target.sample_rows && !alpha_tested && n >= kSampleRowMinPixels &&
+                bool rows = target.sample_rows && n >= kSampleRowMinPixels &&
                             (kMode == SampleMode::single || sample_rows_exact(t, {row0, row1, row2}, n));
                 if (rows) {
                     const std::uint32_t skipped = blocks.row_pixels(cls.skipped, py, rx0, n);
@@ -390,7 +448,6 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     // Depth per sample, colour once per pixel: at the pixel centre when it is inside the
                     // triangle, else at the first covered sample that passed (never extrapolated).
                     std::uint64_t passed = 0;
-                    float z_of[kMaxSamples];  // alpha-tested: the passed samples' depths, written after the shade
                     if (pixel_vectors && covered == all_samples &&
                         test_pixel_samples_avx2(t, {p1, p2, offset1, offset2, S}, covered, kDepth, draw.depth_write,
                                                 depth_px, passed)) {
@@ -403,17 +460,14 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         if constexpr (kDepth != DepthFunc::none) {
                             const float z = sample_depth(t, screen_weights(t, p0 + off0[s], p1 + off1[s], p2 + off2[s]));
                             if (!depth_passes<kDepth>(z, depth_px[s])) continue;
-                            if (alpha_tested) z_of[s] = z;
-                            else if (draw.depth_write) depth_px[s] = z;
+                            if (draw.depth_write) depth_px[s] = z;
                         }
                         passed |= std::uint64_t{1} << s;
                     }
                     if (!passed) continue;
-                    if (!alpha_tested) {
-                        if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
-                        counters.samples_passed += static_cast<std::uint64_t>(count_bits(passed));
-                        ++counters.shader_invocations;
-                    }
+                    if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
+                    counters.samples_passed += static_cast<std::uint64_t>(count_bits(passed));
+                    ++counters.shader_invocations;
                     glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
                     if constexpr (!((kShading == Shading::constant || kShading == Shading::flat) &&
                                     kTexturing == Texturing::none)) {
@@ -425,10 +479,6 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             c2 = p2 + off2[s];
                         }
                         l = screen_weights(t, c0, c1, c2);
-                    }
-                    if (alpha_tested) {
-                        alpha_tested_samples(px, py, passed, l, z_of, depth_px);
-                        continue;
                     }
                     shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px, passed, draw, colors, uvs,
                                                              t, l, batch.clip_weights, px, py);
@@ -446,16 +496,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         if constexpr (kDepth != DepthFunc::none) {
                             const float z = sample_depth(t, l);
                             if (!depth_passes<kDepth>(z, depth_px[s])) continue;
-                            if (alpha_tested) {
-                                float z_of[kMaxSamples];
-                                z_of[s] = z;
-                                alpha_tested_samples(px, py, std::uint64_t{1} << s, l, z_of, depth_px);
-                                continue;
-                            }
                             if (draw.depth_write) depth_px[s] = z;
-                        } else if (alpha_tested) {
-                            alpha_tested_samples(px, py, std::uint64_t{1} << s, l, nullptr, nullptr);
-                            continue;
                         }
                         passed_sample(px, py, s, l);
                     }
