@@ -160,8 +160,9 @@ class Scene:
                 default): off. A fragment whose shaded alpha (color × vertex colour × texture,
                 premultiplied) is below it is discarded: it writes neither colour nor depth. One at
                 or above it is written opaque: rgb divided by its alpha, alpha 1 (then ``blend``
-                applies). Texture lookups of such a draw take the reference path, one sample at a
-                time, and a render with one is not deferred.
+                applies). Such a draw is shaded before its depth is written, sample by sample, and
+                a render with one is not deferred (about 1.1× the draw's time at one sample, 1.7×
+                under MSAA).
 
         Raises:
             TypeError: ``mesh`` is not a Mesh, a flag is not a bool, an option is not a string,

@@ -89,6 +89,39 @@ def test_without_a_cutoff_the_quad_stays_opaque_and_unchanged():
     np.testing.assert_array_equal(mr.render(scene, camera(), W, H).color, texels)
 
 
+def passing_scene(cutoff, sampler):
+    """A tilted, vertex-coloured ground that runs from behind the camera (clipped triangles) to far away,
+    under an opaque texture, and a quad standing on it: every fragment's alpha is exactly 1."""
+    rng = np.random.default_rng(11)
+    texels = np.concatenate([rng.uniform(0.0, 1.0, size=(64, 64, 3)), np.ones((64, 64, 1))], axis=-1)
+    texture = mr.Texture(texels.astype(np.float32), premultiplied=True)
+    ground = mr.Mesh([[-20, 0, 8], [20, 0, 8], [20, 0, -60], [-20, 0, -60]], [[0, 1, 2], [0, 2, 3]],
+                     uvs=[[0, 0], [8, 0], [8, 24], [0, 24]], colors=[[1, 0.5, 0.5, 1], [0.5, 1, 0.5, 1],
+                                                                      [0.5, 0.5, 1, 1], [1, 1, 1, 1]])
+    scene = mr.Scene()
+    scene.add(quad(-3.0), texture=texture, sampler=sampler, alpha_cutoff=cutoff)
+    scene.add(ground, texture=texture, sampler=sampler, alpha_cutoff=cutoff)
+    return scene
+
+
+@pytest.mark.parametrize("spp, aa", [(1, "ssaa"), (4, "msaa"), (4, "ssaa")])
+@pytest.mark.parametrize("sampler", ["trilinear", "anisotropic", "ewa"])
+@pytest.mark.parametrize("batched", [True, False])
+def test_a_draw_whose_fragments_all_pass_is_the_same_draw_without_a_cutoff(spp, aa, sampler, batched):
+    # Alpha 1 everywhere: the test keeps every fragment and divides by 1, so the image is the one the
+    # renderer's other paths (sample rows, MSAA vectors, the lookup queue, deferred shading) make, bit
+    # for bit, when its lookups go the same way (batched or not).
+    camera = mr.Camera.look_at(eye=(0, 1.5, 6), target=(0, 0.5, 0), fov_y=60.0, near=0.1)
+    images = []
+    for cutoff in (None, 0.0, 1.0):
+        result = mr.render(passing_scene(cutoff, mr.Sampler(sampler)), camera, 96, 64, spp=spp, aa=aa,
+                           keep_samples=True, batched_lookups=batched)
+        images.append(result.samples)
+    assert np.isfinite(images[0]).all() and images[0].std() > 0.05
+    for got in images[1:]:
+        np.testing.assert_array_equal(got, images[0])
+
+
 def test_untextured_draw_tests_its_colour_alpha():
     scene = mr.Scene()
     scene.add(quad(0.5, uvs=False), color=(0.2, 0.1, 0.05, 0.4), alpha_cutoff=0.5)  # below: discarded

@@ -90,10 +90,13 @@ inline bool queues_lookups(const DrawInputs& draw) {
 // and only then its depth and colour written. Every other path writes depth as it tests it; a
 // branch for alpha testing inside their loops cost the other draws 3–5 % of the kernel's
 // instructions (many_small MSAA 4x), so alpha-tested triangles take this one, sample by sample.
+// With `sampler` (a textured draw with batched lookups), shades go kLookupBatch at a time through
+// interpolate_batch and the BatchSampler, as the lookup queue sends them: the bits of the same draw
+// without a cutoff; they wait within the triangle only, whose samples are all distinct.
 template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode, Texturing kTexturing>
 [[gnu::noinline]] void alpha_tested_triangle(const TileTarget& target, const DrawInputs& draw, const SetupTriangle& t,
                                              const ClipWeights* clip_weights, int x0, int y0, int x1, int y1,
-                                             TileBlocks& blocks, TileCounters& counters) {
+                                             BatchSampler* sampler, TileBlocks& blocks, TileCounters& counters) {
     const SamplePattern& pattern = *target.pattern;
     const int S = kMode == SampleMode::single ? 1 : pattern.count();
     constexpr std::int64_t kStep = kSubpixelOne;
@@ -108,12 +111,9 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
         for (int i = 0; i < 3; ++i)
             off[i][s] = std::int64_t{t.edge_a[i]} * pattern.x[s] + std::int64_t{t.edge_b[i]} * pattern.y[s];
 
-    // Shades samples `samples` of pixel (px, py) at screen weights l: discarded, or their colour
-    // written and (depth_write) their depths z[s].
-    const auto shade_test_write = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l, const float* z) {
-        counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples));
-        ++counters.shader_invocations;
-        glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, l, clip_weights, px, py);
+    // Samples `samples` of pixel (px, py) with colour c: discarded, or their colour written and
+    // (depth_write) their depths z[s].
+    const auto test_and_write = [&](int px, int py, std::uint64_t samples, glm::vec4 c, const float* z) {
         if (!alpha_test(c, *draw.alpha_cutoff)) return;
         float* const color_px = target.color.at(px, py, 0);
         for (std::uint64_t m = samples; m; m &= m - 1) {
@@ -123,6 +123,53 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
             blend_into<kBlend>(color_px + 4 * s, c);
         }
         if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
+    };
+    // The shades waiting for a batch (with `sampler`): screen weights, pixel, samples, depths.
+    struct Waiting {
+        int px, py;
+        std::uint64_t samples;
+        float z[kMaxSamples];
+    };
+    BatchWeights weights;
+    Waiting waiting[kLookupBatch];
+    LookupBatch lookups;
+    const bool batched = sampler && interpolates_in_batches(draw, kShading, kTexturing, t);
+    const Shading shading = batch_shading(kShading, colors);
+    const auto shade_waiting = [&] {
+        const int n = weights.count;
+        if (!n) return;
+        glm::vec4 colour[kLookupBatch], texel[kLookupBatch];
+        if (batched) {
+            interpolate_batch(draw, shading, kTexturing, t, colors, uvs, weights, colour, lookups);
+        } else {  // (as the lookup queue: interpolated one by one, looked up at once)
+            for (int i = 0; i < n; ++i) {
+                const glm::dvec3 l(weights.l0[i], weights.l1[i], weights.l2[i]);
+                colour[i] = untextured_colour<kShading>(draw, colors, t, l, clip_weights);
+                const UvSample u = texture_lookup<kTexturing>(draw, t, uvs, l, waiting[i].px, waiting[i].py);
+                lookups.set(i, glm::vec2(u.uv), glm::vec2(u.dx), glm::vec2(u.dy));
+            }
+            lookups.count = n;
+        }
+        sampler->sample(lookups, texel);
+        for (int i = 0; i < n; ++i)
+            test_and_write(waiting[i].px, waiting[i].py, waiting[i].samples, colour[i] * texel[i], waiting[i].z);
+        weights.count = 0;
+    };
+    // Shades samples `samples` of pixel (px, py) at screen weights l (their depths z).
+    const auto shade_samples = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l, const float* z) {
+        counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples));
+        ++counters.shader_invocations;
+        if (!sampler) {
+            const glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, l, clip_weights, px, py);
+            test_and_write(px, py, samples, c, z);
+            return;
+        }
+        const int i = weights.count++;
+        weights.l0[i] = l.x, weights.l1[i] = l.y, weights.l2[i] = l.z;
+        waiting[i].px = px, waiting[i].py = py, waiting[i].samples = samples;
+        if constexpr (kDepth != DepthFunc::none)
+            for (std::uint64_t m = samples; m; m &= m - 1) waiting[i].z[__builtin_ctzll(m)] = z[__builtin_ctzll(m)];
+        if (weights.count == kLookupBatch) shade_waiting();
     };
     for (int py = y0; py < y1; ++py) {
         for (int px = x0; px < x1; ++px) {
@@ -151,15 +198,16 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
                 const std::int64_t c2 = p[2] + (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * (kStep / 2);
                 const glm::dvec3 l =
                     (c0 | c1 | c2) >= 0 ? screen_weights(t, c0, c1, c2) : weights_at(__builtin_ctzll(passed));
-                shade_test_write(px, py, passed, l, z);
+                shade_samples(px, py, passed, l, z);
             } else {
                 for (std::uint64_t m = passed; m; m &= m - 1) {
                     const int s = __builtin_ctzll(m);
-                    shade_test_write(px, py, std::uint64_t{1} << s, weights_at(s), z);
+                    shade_samples(px, py, std::uint64_t{1} << s, weights_at(s), z);
                 }
             }
         }
     }
+    shade_waiting();
 }
 
 template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode, Texturing kTexturing>
@@ -176,6 +224,12 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     const bool vector_masks = target.sample_rows && S % 4 == 0 && BatchSampler::widest_vector() == 8;
     std::optional<LookupQueue<kBlend, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
+    // An alpha-tested draw's batched lookups (alpha_tested_triangle), where a draw without a cutoff
+    // would queue them.
+    std::optional<BatchSampler> alpha_sampler;
+    if (kTexturing != Texturing::none && draw.alpha_cutoff && draw.batched_lookups &&
+        draw.debug_view == DebugView::none)
+        alpha_sampler.emplace(*draw.texture, *draw.sampler);
 
     for (std::size_t k = 0; k < batch.count; ++k) {
         const SetupTriangle& t = batch.tris[batch.indices[k]];
@@ -191,8 +245,9 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         if (x0 >= x1 || y0 >= y1) continue;
         if constexpr (kShading != Shading::visibility) {  // (deferred shading never takes alpha-tested draws)
             if (draw.alpha_cutoff) {
-                alpha_tested_triangle<kDepth, kBlend, kShading, kMode, kTexturing>(target, draw, t, batch.clip_weights,
-                                                                                   x0, y0, x1, y1, blocks, counters);
+                alpha_tested_triangle<kDepth, kBlend, kShading, kMode, kTexturing>(
+                    target, draw, t, batch.clip_weights, x0, y0, x1, y1, alpha_sampler ? &*alpha_sampler : nullptr,
+                    blocks, counters);
                 continue;
             }
         }
