@@ -255,6 +255,24 @@ private:
     bool normalized_ = false;
 };
 
+/// T·R·S (glTF 2.0 §3.5.3) from a translation, a rotation quaternion (x, y, z, w), normalized here,
+/// and a scale. Nodes and EXT_mesh_gpu_instancing instances both build their matrices here, so an
+/// instance and a node with the same numbers get the same matrix, bit for bit. A quaternion of
+/// length zero or not finite is an error naming `what`.
+glm::dmat4 trs_matrix(const glm::dvec3& translation, const glm::dvec4& rotation, const glm::dvec3& scale,
+                      const std::string& path, const std::string& what) {
+    glm::dmat4 t(1.0), s(1.0);
+    t[3] = glm::dvec4(translation, 1.0);
+    const glm::dquat q(rotation.w, rotation.x, rotation.y, rotation.z);  // glm takes (w, x, y, z)
+    const double len = glm::length(q);
+    if (!(len > 0.0) || !std::isfinite(len)) fail(path, what + " is not a valid quaternion");
+    const glm::dmat4 r = glm::mat4_cast(q / len);
+    s[0][0] = scale.x;
+    s[1][1] = scale.y;
+    s[2][2] = scale.z;
+    return t * r * s;
+}
+
 glm::dmat4 node_matrix(const tinygltf::Node& node, const std::string& path, int index) {
     const std::string what = "node " + std::to_string(index) + " ('" + node.name + "')";
     if (!node.matrix.empty()) {
@@ -263,25 +281,21 @@ glm::dmat4 node_matrix(const tinygltf::Node& node, const std::string& path, int 
         for (int i = 0; i < 16; ++i) m[i / 4][i % 4] = node.matrix[i];  // column-major, as glTF stores it
         return m;
     }
-    glm::dmat4 t(1.0), r(1.0), s(1.0);
+    glm::dvec3 t(0.0), s(1.0);
+    glm::dvec4 r(0.0, 0.0, 0.0, 1.0);
     if (!node.translation.empty()) {
         if (node.translation.size() != 3) fail(path, what + ": translation must have 3 numbers");
-        t[3] = glm::dvec4(node.translation[0], node.translation[1], node.translation[2], 1.0);
+        t = glm::dvec3(node.translation[0], node.translation[1], node.translation[2]);
     }
     if (!node.rotation.empty()) {
         if (node.rotation.size() != 4) fail(path, what + ": rotation must have 4 numbers");
-        glm::dquat q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);  // (w, x, y, z)
-        const double len = glm::length(q);
-        if (!(len > 0.0) || !std::isfinite(len)) fail(path, what + ": rotation is not a valid quaternion");
-        r = glm::mat4_cast(q / len);
+        r = glm::dvec4(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
     }
     if (!node.scale.empty()) {
         if (node.scale.size() != 3) fail(path, what + ": scale must have 3 numbers");
-        s[0][0] = node.scale[0];
-        s[1][1] = node.scale[1];
-        s[2][2] = node.scale[2];
+        s = glm::dvec3(node.scale[0], node.scale[1], node.scale[2]);
     }
-    return t * r * s;
+    return trs_matrix(t, r, s, path, what + ": rotation");
 }
 
 /// Whether a primitive mode is one of triangles (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN; −1: not
