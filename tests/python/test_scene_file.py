@@ -768,7 +768,8 @@ def test_gltf_required_extension_that_is_not_supported_is_named(tmp_path, extens
         mr.load_scene(path)
 
 
-@pytest.mark.parametrize("extension", ["KHR_texture_transform", "KHR_materials_unlit", "KHR_mesh_quantization"])
+@pytest.mark.parametrize("extension", ["KHR_texture_transform", "KHR_materials_unlit", "KHR_mesh_quantization",
+                                       "EXT_mesh_gpu_instancing"])
 def test_gltf_required_extension_that_is_supported_loads(tmp_path, extension):
     path = write_gltf(tmp_path / "required_ok.gltf")
     doc = json.loads(path.read_text())

@@ -6,13 +6,17 @@
 #include "mipraster/core/constants.hpp"
 #include "mipraster/core/memory_limit.hpp"
 #include "mipraster/io/texture_file.hpp"
+#include "mipraster/pipeline/triangle_setup.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -768,6 +772,8 @@ struct GltfLoader {
             if (static_cast<std::size_t>(node.mesh) >= model.meshes.size())
                 fail(path, "node " + std::to_string(index) + ": mesh " + std::to_string(node.mesh) + " does not exist");
             const tinygltf::Mesh& m = model.meshes[node.mesh];
+            std::vector<Draw> draws;  // one per triangle primitive, at the node's world matrix
+            std::uint64_t triangles = 0;
             for (std::size_t p = 0; p < m.primitives.size(); ++p) {
                 const tinygltf::Primitive& prim = m.primitives[p];
                 if (!draws_triangles(prim.mode)) {
@@ -778,7 +784,19 @@ struct GltfLoader {
                 draw.mesh = primitive_mesh(node.mesh, static_cast<int>(p)).get();
                 draw.model = world;
                 apply_material(draw, prim, node.mesh, static_cast<int>(p));
-                scene.draws.push_back(draw);
+                triangles += draw.mesh->triangles.size();
+                draws.push_back(draw);
+            }
+            if (const auto instances = instance_matrices(node, index, world, draws.size(), triangles)) {
+                // Primitive by primitive, each with all its instances, as a GPU draws them (the order
+                // matters to blending only); every instance shares the primitive's mesh.
+                for (const Draw& draw : draws)
+                    for (const glm::dmat4& instance : *instances) {
+                        scene.draws.push_back(draw);
+                        scene.draws.back().model = instance;
+                    }
+            } else {
+                scene.draws.insert(scene.draws.end(), draws.begin(), draws.end());
             }
         }
 
@@ -791,6 +809,110 @@ struct GltfLoader {
 
         for (int child : node.children) add_node(child, world, depth + 1);
         on_path[index] = false;
+    }
+
+    /// The world matrices of a mesh node's EXT_mesh_gpu_instancing instances: world × T·R·S of each
+    /// instance, from its TRANSLATION (VEC3 float), ROTATION (VEC4 quaternion x, y, z, w: float, or
+    /// normalized byte/short) and SCALE (VEC3 float) accessors, each optional (identity when missing)
+    /// and all of one count; other attributes (_ID, custom ones) are not read. std::nullopt when the
+    /// node has no such extension, or one without any of the three (with a warning): the node is
+    /// drawn once. Before anything is read, instances × (`draws` draws + `triangles` triangles set
+    /// up by a render) are checked against the memory limit, so a few bytes of JSON cannot ask for
+    /// billions of draws. Errors name the node and the accessor.
+    std::optional<std::vector<glm::dmat4>> instance_matrices(const tinygltf::Node& node, int index,
+                                                             const glm::dmat4& world, std::size_t draws,
+                                                             std::uint64_t triangles) {
+        const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
+        if (ext == node.extensions.end()) return std::nullopt;
+        const std::string what =
+            "node " + std::to_string(index) + " ('" + node.name + "'): EXT_mesh_gpu_instancing";
+        const tinygltf::Value& e = ext->second;  // (an object: tinygltf drops extensions that are not)
+        if (!e.Has("attributes") || !e.Get("attributes").IsObject())
+            fail(path, what + ": attributes must be an object");
+        const tinygltf::Value& attributes = e.Get("attributes");
+
+        // The accessors, and their common count, from the accessors' headers alone.
+        struct Attribute {
+            const char* name;
+            int accessor;
+        };
+        std::array<Attribute, 3> trs{{{"TRANSLATION", -1}, {"ROTATION", -1}, {"SCALE", -1}}};
+        const Attribute* first = nullptr;
+        std::size_t count = 0;
+        for (Attribute& a : trs) {
+            if (!attributes.Has(a.name)) continue;
+            const tinygltf::Value& v = attributes.Get(a.name);
+            if (!v.IsInt() || v.GetNumberAsInt() < 0)
+                fail(path, what + ": " + a.name + " must be an accessor index");
+            a.accessor = v.GetNumberAsInt();
+            if (static_cast<std::size_t>(a.accessor) >= model.accessors.size())
+                fail(path, what + ": " + a.name + ": accessor " + std::to_string(a.accessor) +
+                               " does not exist (the file has " + std::to_string(model.accessors.size()) + ")");
+            const std::size_t n = model.accessors[a.accessor].count;
+            if (first == nullptr) {
+                first = &a;
+                count = n;
+            } else if (n != count) {
+                fail(path, what + ": " + a.name + " (accessor " + std::to_string(a.accessor) + ") has " +
+                               std::to_string(n) + " elements, " + first->name + " (accessor " +
+                               std::to_string(first->accessor) + ") " + std::to_string(count) +
+                               "; every instance attribute must have the same count");
+            }
+        }
+        if (first == nullptr) {
+            warn_once(what + " has no TRANSLATION, ROTATION or SCALE attribute; drawn once at the node's transform");
+            return std::nullopt;
+        }
+        const std::string counted = what + " " + first->name + " (accessor " + std::to_string(first->accessor) + ")";
+        if (count > kMaxElements) fail(path, counted + ": absurd instance count " + std::to_string(count));
+        // Every instance is a draw per primitive, and a render transforms and sets up its triangles anew.
+        const double bytes = static_cast<double>(count) *
+                             (static_cast<double>(draws) * sizeof(Draw) +
+                              static_cast<double>(triangles) * sizeof(SetupTriangle));
+        check_memory(bytes < 0x1p63 ? static_cast<std::uint64_t>(bytes) : std::numeric_limits<std::uint64_t>::max(),
+                     path + ": " + counted + ": " + std::to_string(count) + " instances of " +
+                         std::to_string(triangles) + " triangle(s)");
+
+        // The values (bounds, strides, sparse accessors and normalized integers as everywhere).
+        std::vector<glm::dvec3> translation(count, glm::dvec3(0.0)), scale(count, glm::dvec3(1.0));
+        std::vector<glm::dvec4> rotation(count, glm::dvec4(0.0, 0.0, 0.0, 1.0));
+        for (const Attribute& a : trs) {
+            if (a.accessor < 0) continue;
+            const std::string name = a.name;
+            const AccessorReader r(model, a.accessor, path, what + " " + name);
+            const int ct = r.component_type();
+            const bool is_rotation = name == "ROTATION";
+            if (r.components() != (is_rotation ? 4 : 3))
+                fail(path, r.what() + ": " + name + " must be " + (is_rotation ? "VEC4" : "VEC3"));
+            if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+                !(is_rotation && r.normalized() &&
+                  (ct == TINYGLTF_COMPONENT_TYPE_BYTE || ct == TINYGLTF_COMPONENT_TYPE_SHORT)))
+                fail(path, r.what() + ": " + name + " must be float" +
+                               (is_rotation ? " or normalized byte/short" : "") + ", got component type " +
+                               std::to_string(ct) + (r.normalized() ? " (normalized)" : ""));
+            for (std::size_t i = 0; i < count; ++i) {
+                double v[4];
+                for (int c = 0; c < r.components(); ++c) {
+                    v[c] = r.get(i, c);
+                    if (!std::isfinite(v[c]))
+                        fail(path, r.what() + ": " + name + " of instance " + std::to_string(i) + " is not finite");
+                }
+                if (is_rotation) rotation[i] = glm::dvec4(v[0], v[1], v[2], v[3]);
+                else if (name == "TRANSLATION") translation[i] = glm::dvec3(v[0], v[1], v[2]);
+                else scale[i] = glm::dvec3(v[0], v[1], v[2]);
+            }
+        }
+
+        std::vector<glm::dmat4> matrices(count);
+        for (std::size_t i = 0; i < count; ++i) {
+            const std::string instance = what + " instance " + std::to_string(i);
+            matrices[i] = world * trs_matrix(translation[i], rotation[i], scale[i], path, instance + ": ROTATION");
+            for (int col = 0; col < 4; ++col)
+                for (int row = 0; row < 4; ++row)
+                    if (!std::isfinite(matrices[i][col][row]))
+                        fail(path, instance + ": its world matrix is not finite");
+        }
+        return matrices;
     }
 
     NamedCamera make_camera(const tinygltf::Camera& c, int index, const glm::dmat4& world) const {
@@ -834,10 +956,10 @@ struct GltfLoader {
 
 /// The glTF extensions a file may list in extensionsRequired and still load as its author meant:
 /// those this loader reads (KHR_texture_transform on the base colour texture; KHR_mesh_quantization's
-/// integer POSITION, NORMAL and TEXCOORD_n) and those that do not change what it draws
-/// (KHR_materials_unlit: its renders are unlit anyway).
-const std::set<std::string> kSupportedRequiredExtensions = {"KHR_materials_unlit", "KHR_mesh_quantization",
-                                                            "KHR_texture_transform"};
+/// integer POSITION, NORMAL and TEXCOORD_n; EXT_mesh_gpu_instancing's instance transforms) and those
+/// that do not change what it draws (KHR_materials_unlit: its renders are unlit anyway).
+const std::set<std::string> kSupportedRequiredExtensions = {"EXT_mesh_gpu_instancing", "KHR_materials_unlit",
+                                                            "KHR_mesh_quantization", "KHR_texture_transform"};
 
 /// A file that requires another extension (compressed geometry, other image formats, …) cannot
 /// be drawn right: an error naming it. tinygltf only records the list, and without this the load
