@@ -961,6 +961,37 @@ struct GltfLoader {
 const std::set<std::string> kSupportedRequiredExtensions = {"EXT_mesh_gpu_instancing", "KHR_materials_unlit",
                                                             "KHR_mesh_quantization", "KHR_texture_transform"};
 
+/// Extensions in extensionsUsed that cannot change this loader's unlit base-colour render, or whose
+/// fallback it draws, so they get no warning: compressed geometry (a file that only uses it carries
+/// the uncompressed data, which is read) and other image formats (a texture keeps a PNG/JPEG source;
+/// one without is warned about by the material), detail levels (MSFT_lod: the node's own mesh is the
+/// full detail), animation (the rest pose is drawn, as for core glTF animations), metadata, and
+/// normal/roughness texture packing (lighting). Lights (KHR_lights_*, EXT_lights_*) and materials
+/// (KHR_materials_*, see unapplied_extension_effect) are matched by prefix.
+const std::set<std::string> kInvisibleExtensions = {
+    "EXT_instance_features", "EXT_mesh_features", "EXT_mesh_manifold", "EXT_meshopt_compression",
+    "EXT_structural_metadata", "EXT_texture_avif", "EXT_texture_webp", "KHR_animation_pointer",
+    "KHR_draco_mesh_compression", "KHR_meshopt_compression", "KHR_texture_basisu", "KHR_xmp", "KHR_xmp_json_ld",
+    "MSFT_lod", "MSFT_packing_normalRoughnessMetallic", "MSFT_packing_occlusionRoughnessMetallic",
+    "MSFT_texture_dds"};
+
+/// What a render misses when the file uses `extension` and this loader does not apply it: "" for
+/// one it applies (kSupportedRequiredExtensions) or that cannot change the render (kInvisibleExtensions,
+/// lights, and KHR_materials_* other than pbrSpecularGlossiness: sheen, clearcoat, transmission,
+/// volume, ior, specular, emissive strength, iridescence, … are lighting and material effects an
+/// unlit render never shows, and variants are alternatives to the default materials, which are the
+/// ones drawn). Extensions it does not know might change anything: they are named too.
+std::string unapplied_extension_effect(const std::string& extension) {
+    const auto starts = [&](const char* prefix) { return extension.rfind(prefix, 0) == 0; };
+    if (kSupportedRequiredExtensions.count(extension) || kInvisibleExtensions.count(extension)) return "";
+    if (extension == "KHR_materials_pbrSpecularGlossiness")
+        return "its diffuseFactor and diffuseTexture, the base colour of the materials that use it, are not read "
+               "(they are drawn with their pbrMetallicRoughness base colour, white when they give none)";
+    if (extension == "KHR_node_visibility") return "the nodes it hides are drawn";
+    if (starts("KHR_materials_") || starts("KHR_lights_") || starts("EXT_lights_")) return "";
+    return "this loader does not know it, and whatever it changes is not drawn";
+}
+
 /// A file that requires another extension (compressed geometry, other image formats, …) cannot
 /// be drawn right: an error naming it. tinygltf only records the list, and without this the load
 /// failed later on what the extension changes, e.g. "accessor[1] invalid bufferView" for Draco.
@@ -1013,6 +1044,11 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
             line.rfind("File is empty : ", 0) != 0 && line.rfind("Failed to load external 'uri' for image[", 0) != 0)
             kept += line + "\n";
     add_warnings(g.scene.warnings, path, kept);
+    // An extension the file uses that changes what it looks like but is not applied is named (once).
+    for (const std::string& extension : model.extensionsUsed)
+        if (const std::string effect = unapplied_extension_effect(extension); !effect.empty())
+            g.warn_once("the file uses the glTF extension '" + extension + "', which this loader does not apply: " +
+                        effect);
 
     // Roots: the default scene, else scene 0, else every node that is no other node's child.
     std::vector<int> roots;
