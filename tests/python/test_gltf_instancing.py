@@ -255,3 +255,21 @@ def test_bad_instances_are_errors_naming_the_node_and_accessor(tmp_path, case):
         problem = r"EXT_mesh_gpu_instancing: SCALE: accessor 9 does not exist \(the file has 4\)"
     with pytest.raises(error, match=r"bad\.gltf: node 0 \('trees'\): " + problem):
         mr.load_scene(path)
+
+
+def test_instance_whose_world_matrix_overflows_is_an_error(tmp_path):
+    path = write_instanced(tmp_path / "overflow.gltf", {"SCALE": SCALE * 1e30}, node={"scale": [1e300, 1, 1]})
+    with pytest.raises(OSError, match=r"overflow\.gltf: node 0 \('trees'\): EXT_mesh_gpu_instancing instance 0: "
+                                      r"its world matrix is not finite"):
+        mr.load_scene(path)
+
+
+def test_absurd_instance_count_is_refused_even_without_triangles(tmp_path):
+    # A mesh of points only draws nothing, but a billion instances would still be a billion matrices.
+    path = write_instanced(tmp_path / "points.gltf", {"TRANSLATION": TRANSLATION}, TRANSLATION={"count": HUGE})
+    doc = json.loads(path.read_text())
+    doc["meshes"][0]["primitives"][0]["mode"] = 0
+    path.write_text(json.dumps(doc))
+    with pytest.raises(mr.MemoryLimitError, match=rf"points\.gltf: node 0 \('trees'\): EXT_mesh_gpu_instancing "
+                                                  rf"TRANSLATION \(accessor 3\): {HUGE} instances of 0 triangle"):
+        mr.load_scene(path)

@@ -816,9 +816,9 @@ struct GltfLoader {
     /// normalized byte/short) and SCALE (VEC3 float) accessors, each optional (identity when missing)
     /// and all of one count; other attributes (_ID, custom ones) are not read. std::nullopt when the
     /// node has no such extension, or one without any of the three (with a warning): the node is
-    /// drawn once. Before anything is read, instances × (`draws` draws + `triangles` triangles set
-    /// up by a render) are checked against the memory limit, so a few bytes of JSON cannot ask for
-    /// billions of draws. Errors name the node and the accessor.
+    /// drawn once. Before anything is read, instances × (a matrix, `draws` draws and `triangles`
+    /// triangles set up by a render) are checked against the memory limit, so a few bytes of JSON
+    /// cannot ask for billions of draws. Errors name the node and the accessor.
     std::optional<std::vector<glm::dmat4>> instance_matrices(const tinygltf::Node& node, int index,
                                                              const glm::dmat4& world, std::size_t draws,
                                                              std::uint64_t triangles) {
@@ -865,21 +865,21 @@ struct GltfLoader {
         }
         const std::string counted = what + " " + first->name + " (accessor " + std::to_string(first->accessor) + ")";
         if (count > kMaxElements) fail(path, counted + ": absurd instance count " + std::to_string(count));
-        // Every instance is a draw per primitive, and a render transforms and sets up its triangles anew.
+        // Every instance is a matrix here and a draw per primitive, and a render transforms and sets
+        // up its triangles anew.
         const double bytes = static_cast<double>(count) *
-                             (static_cast<double>(draws) * sizeof(Draw) +
+                             (sizeof(glm::dmat4) + static_cast<double>(draws) * sizeof(Draw) +
                               static_cast<double>(triangles) * sizeof(SetupTriangle));
         check_memory(bytes < 0x1p63 ? static_cast<std::uint64_t>(bytes) : std::numeric_limits<std::uint64_t>::max(),
                      path + ": " + counted + ": " + std::to_string(count) + " instances of " +
                          std::to_string(triangles) + " triangle(s)");
 
-        // The values (bounds, strides, sparse accessors and normalized integers as everywhere).
-        std::vector<glm::dvec3> translation(count, glm::dvec3(0.0)), scale(count, glm::dvec3(1.0));
-        std::vector<glm::dvec4> rotation(count, glm::dvec4(0.0, 0.0, 0.0, 1.0));
-        for (const Attribute& a : trs) {
-            if (a.accessor < 0) continue;
-            const std::string name = a.name;
-            const AccessorReader r(model, a.accessor, path, what + " " + name);
+        // The accessors, checked and read as everywhere (bounds, strides, sparse, normalized integers).
+        std::array<std::optional<AccessorReader>, 3> readers;
+        for (std::size_t k = 0; k < trs.size(); ++k) {
+            if (trs[k].accessor < 0) continue;
+            const std::string name = trs[k].name;
+            const AccessorReader& r = readers[k].emplace(model, trs[k].accessor, path, what + " " + name);
             const int ct = r.component_type();
             const bool is_rotation = name == "ROTATION";
             if (r.components() != (is_rotation ? 4 : 3))
@@ -890,23 +890,24 @@ struct GltfLoader {
                 fail(path, r.what() + ": " + name + " must be float" +
                                (is_rotation ? " or normalized byte/short" : "") + ", got component type " +
                                std::to_string(ct) + (r.normalized() ? " (normalized)" : ""));
-            for (std::size_t i = 0; i < count; ++i) {
-                double v[4];
-                for (int c = 0; c < r.components(); ++c) {
-                    v[c] = r.get(i, c);
-                    if (!std::isfinite(v[c]))
-                        fail(path, r.what() + ": " + name + " of instance " + std::to_string(i) + " is not finite");
-                }
-                if (is_rotation) rotation[i] = glm::dvec4(v[0], v[1], v[2], v[3]);
-                else if (name == "TRANSLATION") translation[i] = glm::dvec3(v[0], v[1], v[2]);
-                else scale[i] = glm::dvec3(v[0], v[1], v[2]);
-            }
         }
 
         std::vector<glm::dmat4> matrices(count);
         for (std::size_t i = 0; i < count; ++i) {
+            double v[3][4] = {{0.0, 0.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 1.0}, {1.0, 1.0, 1.0, 0.0}};  // the identity
+            for (std::size_t k = 0; k < readers.size(); ++k) {
+                if (!readers[k]) continue;
+                for (int c = 0; c < readers[k]->components(); ++c) {
+                    v[k][c] = readers[k]->get(i, c);
+                    if (!std::isfinite(v[k][c]))
+                        fail(path, readers[k]->what() + ": " + trs[k].name + " of instance " + std::to_string(i) +
+                                       " is not finite");
+                }
+            }
             const std::string instance = what + " instance " + std::to_string(i);
-            matrices[i] = world * trs_matrix(translation[i], rotation[i], scale[i], path, instance + ": ROTATION");
+            matrices[i] = world * trs_matrix(glm::dvec3(v[0][0], v[0][1], v[0][2]),
+                                             glm::dvec4(v[1][0], v[1][1], v[1][2], v[1][3]),
+                                             glm::dvec3(v[2][0], v[2][1], v[2][2]), path, instance + ": ROTATION");
             for (int col = 0; col < 4; ++col)
                 for (int row = 0; row < 4; ++row)
                     if (!std::isfinite(matrices[i][col][row]))
