@@ -371,6 +371,44 @@ TEST(SceneFile, NodeCycleIsAnError) {
     EXPECT_NE(e.find(path), std::string::npos) << e;
 }
 
+TEST(SceneFile, GltfInstancingDrawsEachInstanceWithTheSharedMesh) {
+    // Node 0 gets two EXT_mesh_gpu_instancing instances: translation (1, 0, 0) with a quarter turn
+    // about z (a normalized short quaternion), and translation (0, −1, 0.5) unrotated. An _ID
+    // attribute of another count is not read; the child node 1 is not instanced.
+    std::vector<unsigned char> buffer = triangle_buffer();
+    for (float v : {1.f, 0.f, 0.f, 0.f, -1.f, 0.5f}) append(buffer, v);
+    for (std::int16_t q : {0, 0, 23170, 23170, 0, 0, 0, 32767}) append(buffer, q);
+    std::string json = gltf_json("\"uri\": \"data:application/octet-stream;base64," + base64(buffer) + "\", ",
+                                 buffer.size());
+    const auto replace = [&](const std::string& from, const std::string& to) {
+        ASSERT_NE(json.find(from), std::string::npos) << from;
+        json.replace(json.find(from), from.size(), to);
+    };
+    replace(R"("asset")", R"("extensionsUsed": ["EXT_mesh_gpu_instancing"],
+  "extensionsRequired": ["EXT_mesh_gpu_instancing"],
+  "asset")");
+    replace(R"("children": [1]})", R"("children": [1],
+     "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 3, "ROTATION": 4, "_ID": 2}}}})");
+    replace(R"("count": 3, "type": "SCALAR"})", R"("count": 3, "type": "SCALAR"},
+    {"bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3"},
+    {"bufferView": 4, "componentType": 5122, "normalized": true, "count": 2, "type": "VEC4"})");
+    replace(R"("byteOffset": 48, "byteLength": 6})", R"("byteOffset": 48, "byteLength": 6},
+    {"buffer": 0, "byteOffset": 56, "byteLength": 24},
+    {"buffer": 0, "byteOffset": 80, "byteLength": 16})");
+    const mr::LoadedScene s = mr::load_scene(write_file("instanced.gltf", json));
+
+    ASSERT_EQ(s.meshes.size(), 1u);
+    ASSERT_EQ(s.draws.size(), 3u);
+    for (const mr::Draw& d : s.draws) EXPECT_EQ(d.mesh, s.meshes[0].get());  // shared, not copied
+    const glm::dmat4 node = glm::translate(glm::dmat4(1.0), glm::dvec3(1, 2, 3));
+    const glm::dmat4 quarter_turn(glm::dvec4(0, 1, 0, 0), glm::dvec4(-1, 0, 0, 0), glm::dvec4(0, 0, 1, 0),
+                                  glm::dvec4(0, 0, 0, 1));  // columns: x → y, y → −x
+    expect_mat_near(s.draws[0].model, glm::translate(node, glm::dvec3(1, 0, 0)) * quarter_turn);
+    expect_mat_near(s.draws[1].model, glm::translate(node, glm::dvec3(0, -1, 0.5)));
+    expect_mat_near(s.draws[2].model, glm::scale(node, glm::dvec3(2.0)));
+    for (const std::string& w : s.warnings) EXPECT_EQ(w.find("extension"), std::string::npos) << w;
+}
+
 // --- textures -----------------------------------------------------------------------------------
 
 namespace {

@@ -768,7 +768,8 @@ def test_gltf_required_extension_that_is_not_supported_is_named(tmp_path, extens
         mr.load_scene(path)
 
 
-@pytest.mark.parametrize("extension", ["KHR_texture_transform", "KHR_materials_unlit", "KHR_mesh_quantization"])
+@pytest.mark.parametrize("extension", ["KHR_texture_transform", "KHR_materials_unlit", "KHR_mesh_quantization",
+                                       "EXT_mesh_gpu_instancing"])
 def test_gltf_required_extension_that_is_supported_loads(tmp_path, extension):
     path = write_gltf(tmp_path / "required_ok.gltf")
     doc = json.loads(path.read_text())
@@ -778,6 +779,37 @@ def test_gltf_required_extension_that_is_supported_loads(tmp_path, extension):
         warnings.simplefilter("error")
         scene, _ = mr.load_scene(path)
     assert len(scene.draws[0].mesh.triangles) == 1
+
+
+# extensionsUsed: an extension that changes what the file looks like and that the loader does not
+# apply is named once; those that cannot change an unlit base-colour render (lighting and material
+# effects, lights), whose fallback is drawn (compression, image formats, detail levels) or that the
+# loader applies are not.
+
+def test_gltf_used_extensions_the_loader_does_not_apply_are_warned_about_once(tmp_path):
+    used = ["KHR_materials_pbrSpecularGlossiness", "KHR_node_visibility", "VENDOR_made_up_effect",
+            "KHR_materials_pbrSpecularGlossiness",  # listed twice: still one warning
+            "EXT_mesh_gpu_instancing", "KHR_texture_transform", "KHR_materials_unlit", "KHR_mesh_quantization",
+            "KHR_materials_sheen", "KHR_materials_clearcoat", "KHR_materials_transmission", "KHR_materials_volume",
+            "KHR_materials_ior", "KHR_materials_specular", "KHR_materials_emissive_strength",
+            "KHR_materials_iridescence", "KHR_materials_anisotropy", "KHR_materials_variants",
+            "KHR_lights_punctual", "EXT_lights_image_based", "KHR_draco_mesh_compression", "EXT_meshopt_compression",
+            "KHR_texture_basisu", "EXT_texture_webp", "EXT_texture_avif", "MSFT_lod", "KHR_animation_pointer",
+            "KHR_xmp_json_ld"]
+    path = write_gltf(tmp_path / "used.gltf")
+    doc = json.loads(path.read_text())
+    doc["extensionsUsed"] = used
+    path.write_text(json.dumps(doc))
+    scene, texts = load_warning_texts(path)
+    assert len(scene.draws) == 1
+    named = sorted(re.search(r"glTF extension '([^']*)'", t).group(1) for t in texts)
+    assert named == ["KHR_materials_pbrSpecularGlossiness", "KHR_node_visibility", "VENDOR_made_up_effect"], texts
+    for text in texts:
+        assert text.startswith(str(path) + ": the file uses the glTF extension '")
+        assert "which this loader does not apply: " in text
+    assert any("diffuseFactor and diffuseTexture" in t for t in texts)
+    assert any("the nodes it hides are drawn" in t for t in texts)
+    assert any("this loader does not know it" in t for t in texts)
 
 
 def test_gltf_mesh_quantization_texcoords(tmp_path):

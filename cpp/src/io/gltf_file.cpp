@@ -6,13 +6,17 @@
 #include "mipraster/core/constants.hpp"
 #include "mipraster/core/memory_limit.hpp"
 #include "mipraster/io/texture_file.hpp"
+#include "mipraster/pipeline/triangle_setup.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -255,6 +259,24 @@ private:
     bool normalized_ = false;
 };
 
+/// T·R·S (glTF 2.0 §3.5.3) from a translation, a rotation quaternion (x, y, z, w), normalized here,
+/// and a scale. Nodes and EXT_mesh_gpu_instancing instances both build their matrices here, so an
+/// instance and a node with the same numbers get the same matrix, bit for bit. A quaternion of
+/// length zero or not finite is an error naming `what`.
+glm::dmat4 trs_matrix(const glm::dvec3& translation, const glm::dvec4& rotation, const glm::dvec3& scale,
+                      const std::string& path, const std::string& what) {
+    glm::dmat4 t(1.0), s(1.0);
+    t[3] = glm::dvec4(translation, 1.0);
+    const glm::dquat q(rotation.w, rotation.x, rotation.y, rotation.z);  // glm takes (w, x, y, z)
+    const double len = glm::length(q);
+    if (!(len > 0.0) || !std::isfinite(len)) fail(path, what + " is not a valid quaternion");
+    const glm::dmat4 r = glm::mat4_cast(q / len);
+    s[0][0] = scale.x;
+    s[1][1] = scale.y;
+    s[2][2] = scale.z;
+    return t * r * s;
+}
+
 glm::dmat4 node_matrix(const tinygltf::Node& node, const std::string& path, int index) {
     const std::string what = "node " + std::to_string(index) + " ('" + node.name + "')";
     if (!node.matrix.empty()) {
@@ -263,25 +285,21 @@ glm::dmat4 node_matrix(const tinygltf::Node& node, const std::string& path, int 
         for (int i = 0; i < 16; ++i) m[i / 4][i % 4] = node.matrix[i];  // column-major, as glTF stores it
         return m;
     }
-    glm::dmat4 t(1.0), r(1.0), s(1.0);
+    glm::dvec3 t(0.0), s(1.0);
+    glm::dvec4 r(0.0, 0.0, 0.0, 1.0);
     if (!node.translation.empty()) {
         if (node.translation.size() != 3) fail(path, what + ": translation must have 3 numbers");
-        t[3] = glm::dvec4(node.translation[0], node.translation[1], node.translation[2], 1.0);
+        t = glm::dvec3(node.translation[0], node.translation[1], node.translation[2]);
     }
     if (!node.rotation.empty()) {
         if (node.rotation.size() != 4) fail(path, what + ": rotation must have 4 numbers");
-        glm::dquat q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);  // (w, x, y, z)
-        const double len = glm::length(q);
-        if (!(len > 0.0) || !std::isfinite(len)) fail(path, what + ": rotation is not a valid quaternion");
-        r = glm::mat4_cast(q / len);
+        r = glm::dvec4(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
     }
     if (!node.scale.empty()) {
         if (node.scale.size() != 3) fail(path, what + ": scale must have 3 numbers");
-        s[0][0] = node.scale[0];
-        s[1][1] = node.scale[1];
-        s[2][2] = node.scale[2];
+        s = glm::dvec3(node.scale[0], node.scale[1], node.scale[2]);
     }
-    return t * r * s;
+    return trs_matrix(t, r, s, path, what + ": rotation");
 }
 
 /// Whether a primitive mode is one of triangles (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN; −1: not
@@ -754,6 +772,8 @@ struct GltfLoader {
             if (static_cast<std::size_t>(node.mesh) >= model.meshes.size())
                 fail(path, "node " + std::to_string(index) + ": mesh " + std::to_string(node.mesh) + " does not exist");
             const tinygltf::Mesh& m = model.meshes[node.mesh];
+            std::vector<Draw> draws;  // one per triangle primitive, at the node's world matrix
+            std::uint64_t triangles = 0;
             for (std::size_t p = 0; p < m.primitives.size(); ++p) {
                 const tinygltf::Primitive& prim = m.primitives[p];
                 if (!draws_triangles(prim.mode)) {
@@ -764,7 +784,19 @@ struct GltfLoader {
                 draw.mesh = primitive_mesh(node.mesh, static_cast<int>(p)).get();
                 draw.model = world;
                 apply_material(draw, prim, node.mesh, static_cast<int>(p));
-                scene.draws.push_back(draw);
+                triangles += draw.mesh->triangles.size();
+                draws.push_back(draw);
+            }
+            if (const auto instances = instance_matrices(node, index, world, draws.size(), triangles)) {
+                // Primitive by primitive, each with all its instances, as a GPU draws them (the order
+                // matters to blending only); every instance shares the primitive's mesh.
+                for (const Draw& draw : draws)
+                    for (const glm::dmat4& instance : *instances) {
+                        scene.draws.push_back(draw);
+                        scene.draws.back().model = instance;
+                    }
+            } else {
+                scene.draws.insert(scene.draws.end(), draws.begin(), draws.end());
             }
         }
 
@@ -777,6 +809,111 @@ struct GltfLoader {
 
         for (int child : node.children) add_node(child, world, depth + 1);
         on_path[index] = false;
+    }
+
+    /// The world matrices of a mesh node's EXT_mesh_gpu_instancing instances: world × T·R·S of each
+    /// instance, from its TRANSLATION (VEC3 float), ROTATION (VEC4 quaternion x, y, z, w: float, or
+    /// normalized byte/short) and SCALE (VEC3 float) accessors, each optional (identity when missing)
+    /// and all of one count; other attributes (_ID, custom ones) are not read. std::nullopt when the
+    /// node has no such extension, or one without any of the three (with a warning): the node is
+    /// drawn once. Before anything is read, instances × (a matrix, `draws` draws and `triangles`
+    /// triangles set up by a render) are checked against the memory limit, so a few bytes of JSON
+    /// cannot ask for billions of draws. Errors name the node and the accessor.
+    std::optional<std::vector<glm::dmat4>> instance_matrices(const tinygltf::Node& node, int index,
+                                                             const glm::dmat4& world, std::size_t draws,
+                                                             std::uint64_t triangles) {
+        const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
+        if (ext == node.extensions.end()) return std::nullopt;
+        const std::string what =
+            "node " + std::to_string(index) + " ('" + node.name + "'): EXT_mesh_gpu_instancing";
+        const tinygltf::Value& e = ext->second;  // (an object: tinygltf drops extensions that are not)
+        if (!e.Has("attributes") || !e.Get("attributes").IsObject())
+            fail(path, what + ": attributes must be an object");
+        const tinygltf::Value& attributes = e.Get("attributes");
+
+        // The accessors, and their common count, from the accessors' headers alone.
+        struct Attribute {
+            const char* name;
+            int accessor;
+        };
+        std::array<Attribute, 3> trs{{{"TRANSLATION", -1}, {"ROTATION", -1}, {"SCALE", -1}}};
+        const Attribute* first = nullptr;
+        std::size_t count = 0;
+        for (Attribute& a : trs) {
+            if (!attributes.Has(a.name)) continue;
+            const tinygltf::Value& v = attributes.Get(a.name);
+            if (!v.IsInt() || v.GetNumberAsInt() < 0)
+                fail(path, what + ": " + a.name + " must be an accessor index");
+            a.accessor = v.GetNumberAsInt();
+            if (static_cast<std::size_t>(a.accessor) >= model.accessors.size())
+                fail(path, what + ": " + a.name + ": accessor " + std::to_string(a.accessor) +
+                               " does not exist (the file has " + std::to_string(model.accessors.size()) + ")");
+            const std::size_t n = model.accessors[a.accessor].count;
+            if (first == nullptr) {
+                first = &a;
+                count = n;
+            } else if (n != count) {
+                fail(path, what + ": " + a.name + " (accessor " + std::to_string(a.accessor) + ") has " +
+                               std::to_string(n) + " elements, " + first->name + " (accessor " +
+                               std::to_string(first->accessor) + ") " + std::to_string(count) +
+                               "; every instance attribute must have the same count");
+            }
+        }
+        if (first == nullptr) {
+            warn_once(what + " has no TRANSLATION, ROTATION or SCALE attribute; drawn once at the node's transform");
+            return std::nullopt;
+        }
+        const std::string counted = what + " " + first->name + " (accessor " + std::to_string(first->accessor) + ")";
+        if (count > kMaxElements) fail(path, counted + ": absurd instance count " + std::to_string(count));
+        // Every instance is a matrix here and a draw per primitive, and a render transforms and sets
+        // up its triangles anew.
+        const double bytes = static_cast<double>(count) *
+                             (sizeof(glm::dmat4) + static_cast<double>(draws) * sizeof(Draw) +
+                              static_cast<double>(triangles) * sizeof(SetupTriangle));
+        check_memory(bytes < 0x1p63 ? static_cast<std::uint64_t>(bytes) : std::numeric_limits<std::uint64_t>::max(),
+                     path + ": " + counted + ": " + std::to_string(count) + " instances of " +
+                         std::to_string(triangles) + " triangle(s)");
+
+        // The accessors, checked and read as everywhere (bounds, strides, sparse, normalized integers).
+        std::array<std::optional<AccessorReader>, 3> readers;
+        for (std::size_t k = 0; k < trs.size(); ++k) {
+            if (trs[k].accessor < 0) continue;
+            const std::string name = trs[k].name;
+            const AccessorReader& r = readers[k].emplace(model, trs[k].accessor, path, what + " " + name);
+            const int ct = r.component_type();
+            const bool is_rotation = name == "ROTATION";
+            if (r.components() != (is_rotation ? 4 : 3))
+                fail(path, r.what() + ": " + name + " must be " + (is_rotation ? "VEC4" : "VEC3"));
+            if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+                !(is_rotation && r.normalized() &&
+                  (ct == TINYGLTF_COMPONENT_TYPE_BYTE || ct == TINYGLTF_COMPONENT_TYPE_SHORT)))
+                fail(path, r.what() + ": " + name + " must be float" +
+                               (is_rotation ? " or normalized byte/short" : "") + ", got component type " +
+                               std::to_string(ct) + (r.normalized() ? " (normalized)" : ""));
+        }
+
+        std::vector<glm::dmat4> matrices(count);
+        for (std::size_t i = 0; i < count; ++i) {
+            double v[3][4] = {{0.0, 0.0, 0.0, 0.0}, {0.0, 0.0, 0.0, 1.0}, {1.0, 1.0, 1.0, 0.0}};  // the identity
+            for (std::size_t k = 0; k < readers.size(); ++k) {
+                if (!readers[k]) continue;
+                for (int c = 0; c < readers[k]->components(); ++c) {
+                    v[k][c] = readers[k]->get(i, c);
+                    if (!std::isfinite(v[k][c]))
+                        fail(path, readers[k]->what() + ": " + trs[k].name + " of instance " + std::to_string(i) +
+                                       " is not finite");
+                }
+            }
+            const std::string instance = what + " instance " + std::to_string(i);
+            matrices[i] = world * trs_matrix(glm::dvec3(v[0][0], v[0][1], v[0][2]),
+                                             glm::dvec4(v[1][0], v[1][1], v[1][2], v[1][3]),
+                                             glm::dvec3(v[2][0], v[2][1], v[2][2]), path, instance + ": ROTATION");
+            for (int col = 0; col < 4; ++col)
+                for (int row = 0; row < 4; ++row)
+                    if (!std::isfinite(matrices[i][col][row]))
+                        fail(path, instance + ": its world matrix is not finite");
+        }
+        return matrices;
     }
 
     NamedCamera make_camera(const tinygltf::Camera& c, int index, const glm::dmat4& world) const {
@@ -820,10 +957,41 @@ struct GltfLoader {
 
 /// The glTF extensions a file may list in extensionsRequired and still load as its author meant:
 /// those this loader reads (KHR_texture_transform on the base colour texture; KHR_mesh_quantization's
-/// integer POSITION, NORMAL and TEXCOORD_n) and those that do not change what it draws
-/// (KHR_materials_unlit: its renders are unlit anyway).
-const std::set<std::string> kSupportedRequiredExtensions = {"KHR_materials_unlit", "KHR_mesh_quantization",
-                                                            "KHR_texture_transform"};
+/// integer POSITION, NORMAL and TEXCOORD_n; EXT_mesh_gpu_instancing's instance transforms) and those
+/// that do not change what it draws (KHR_materials_unlit: its renders are unlit anyway).
+const std::set<std::string> kSupportedRequiredExtensions = {"EXT_mesh_gpu_instancing", "KHR_materials_unlit",
+                                                            "KHR_mesh_quantization", "KHR_texture_transform"};
+
+/// Extensions in extensionsUsed that cannot change this loader's unlit base-colour render, or whose
+/// fallback it draws, so they get no warning: compressed geometry (a file that only uses it carries
+/// the uncompressed data, which is read) and other image formats (a texture keeps a PNG/JPEG source;
+/// one without is warned about by the material), detail levels (MSFT_lod: the node's own mesh is the
+/// full detail), animation (the rest pose is drawn, as for core glTF animations), metadata, and
+/// normal/roughness texture packing (lighting). Lights (KHR_lights_*, EXT_lights_*) and materials
+/// (KHR_materials_*, see unapplied_extension_effect) are matched by prefix.
+const std::set<std::string> kInvisibleExtensions = {
+    "EXT_instance_features", "EXT_mesh_features", "EXT_mesh_manifold", "EXT_meshopt_compression",
+    "EXT_structural_metadata", "EXT_texture_avif", "EXT_texture_webp", "KHR_animation_pointer",
+    "KHR_draco_mesh_compression", "KHR_meshopt_compression", "KHR_texture_basisu", "KHR_xmp", "KHR_xmp_json_ld",
+    "MSFT_lod", "MSFT_packing_normalRoughnessMetallic", "MSFT_packing_occlusionRoughnessMetallic",
+    "MSFT_texture_dds"};
+
+/// What a render misses when the file uses `extension` and this loader does not apply it: "" for
+/// one it applies (kSupportedRequiredExtensions) or that cannot change the render (kInvisibleExtensions,
+/// lights, and KHR_materials_* other than pbrSpecularGlossiness: sheen, clearcoat, transmission,
+/// volume, ior, specular, emissive strength, iridescence, … are lighting and material effects an
+/// unlit render never shows, and variants are alternatives to the default materials, which are the
+/// ones drawn). Extensions it does not know might change anything: they are named too.
+std::string unapplied_extension_effect(const std::string& extension) {
+    const auto starts = [&](const char* prefix) { return extension.rfind(prefix, 0) == 0; };
+    if (kSupportedRequiredExtensions.count(extension) || kInvisibleExtensions.count(extension)) return "";
+    if (extension == "KHR_materials_pbrSpecularGlossiness")
+        return "its diffuseFactor and diffuseTexture, the base colour of the materials that use it, are not read "
+               "(they are drawn with their pbrMetallicRoughness base colour, white when they give none)";
+    if (extension == "KHR_node_visibility") return "the nodes it hides are drawn";
+    if (starts("KHR_materials_") || starts("KHR_lights_") || starts("EXT_lights_")) return "";
+    return "this loader does not know it, and whatever it changes is not drawn";
+}
 
 /// A file that requires another extension (compressed geometry, other image formats, …) cannot
 /// be drawn right: an error naming it. tinygltf only records the list, and without this the load
@@ -877,6 +1045,11 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
             line.rfind("File is empty : ", 0) != 0 && line.rfind("Failed to load external 'uri' for image[", 0) != 0)
             kept += line + "\n";
     add_warnings(g.scene.warnings, path, kept);
+    // An extension the file uses that changes what it looks like but is not applied is named (once).
+    for (const std::string& extension : model.extensionsUsed)
+        if (const std::string effect = unapplied_extension_effect(extension); !effect.empty())
+            g.warn_once("the file uses the glTF extension '" + extension + "', which this loader does not apply: " +
+                        effect);
 
     // Roots: the default scene, else scene 0, else every node that is no other node's child.
     std::vector<int> roots;

@@ -108,8 +108,18 @@ struct LoadedScene {
 ///    reads, or whose texture has no source image is skipped with a warning (the draw is
 ///    untextured). The texture's KHR_texture_transform is applied to the mesh's uvs as they are
 ///    read: uv' = T(offset)·R(rotation)·S(scale)·uv with R = [[cos, sin], [−sin, cos]] (row by
-///    row, as Khronos' sample models use it), and its texCoord overrides the texture's. Cameras
-///    attached to nodes become NamedCameras in node order.
+///    row, as Khronos' sample models use it), and its texCoord overrides the texture's. A mesh node
+///    with EXT_mesh_gpu_instancing is drawn once per instance: each triangle primitive, with all
+///    its instances in order, as draws that share the primitive's mesh, at model = node world
+///    matrix × T·R·S of the instance (TRANSLATION and SCALE VEC3 float, ROTATION VEC4 quaternion
+///    x, y, z, w, float or normalized byte/short; a missing one is the identity; other attributes
+///    such as _ID are not read; the node's children are not instanced; a node without a mesh ignores
+///    the extension, one without any of the three attributes is drawn once with a warning). Cameras
+///    attached to nodes become NamedCameras in node order. Each extension in extensionsUsed that can
+///    change how the file looks and that the loader does not apply (KHR_materials_pbrSpecularGlossiness,
+///    KHR_node_visibility, and extensions it does not know) gives one warning naming it; lights,
+///    KHR_materials_* lighting and material effects, and extensions whose fallback is drawn
+///    (compressed geometry, other image formats, MSFT_lod), animation and metadata give none.
 /// A texture file that is missing, unreadable or corrupt does not stop the load: the draw gets
 /// error_texture() (an 8×8 magenta/black checker) and a warning naming the material and the
 /// file. Images are shared through the texture cache (load_texture), so loading the same files
@@ -120,12 +130,14 @@ struct LoadedScene {
 /// accessor outside its buffer or of the wrong type or count (e.g. TEXCOORD_0 that is not VEC2),
 /// a sparse accessor whose indices are out of range, not strictly increasing or of a type other
 /// than unsigned byte/short/int, whose index or value views lie outside their buffers, or whose
-/// sparse count exceeds its count, an extensionsRequired entry other than KHR_materials_unlit,
-/// KHR_mesh_quantization and KHR_texture_transform (e.g. Draco or meshopt compression),
-/// KHR_texture_transform values of the wrong type or length
-/// (naming the material), an index out of range (vertex, texture coordinate, normal,
-/// material, texture, sampler, image source), an image bufferView outside its buffer, a node
-/// cycle or absurd counts.
+/// sparse count exceeds its count, an extensionsRequired entry other than EXT_mesh_gpu_instancing,
+/// KHR_materials_unlit, KHR_mesh_quantization and KHR_texture_transform (e.g. Draco or meshopt
+/// compression), KHR_texture_transform values of the wrong type or length
+/// (naming the material), EXT_mesh_gpu_instancing accessors of unequal counts, of the wrong type,
+/// with non-finite values or a zero quaternion (naming the node and the accessor), an index out of
+/// range (vertex, texture coordinate, normal, material, texture, sampler, image source, instance
+/// accessor), an image bufferView outside its buffer, a node cycle or absurd counts; MemoryLimitError
+/// when a node's instances × (its draws and the triangles a render sets up) exceed memory_limit().
 LoadedScene load_scene(const std::string& path);
 
 /// World-space axis-aligned bounds of the draws' vertices (model matrices applied). Returns
