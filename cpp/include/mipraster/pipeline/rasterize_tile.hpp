@@ -81,9 +81,9 @@ struct DrawInputs {
     const glm::vec4* vertex_colors;  ///< null when the mesh has none (then shading is constant)
     glm::vec4 color;
     bool depth_write;
-    /// DrawState::alpha_cutoff. When set, the kernel shades before it writes depth: it takes its
-    /// per-sample paths (not the sample rows, MSAA's pixel vectors or the lookup queue, which
-    /// write depth before the colour is known), and a draw with it cannot be deferred.
+    /// DrawState::alpha_cutoff. When set, the kernel shades before it writes depth: each triangle
+    /// takes alpha_tested_triangle (not the sample rows, MSAA's pixel vectors or the lookup queue,
+    /// which write depth before the colour is known), and a draw with it cannot be deferred.
     std::optional<float> alpha_cutoff = std::nullopt;
     // Texturing only:
     const glm::vec2* uvs = nullptr;
