@@ -738,30 +738,37 @@ MaterialTexture map_kd_texture(const std::string& obj_path, const ObjMaterial& m
     const std::string mask_file = m.map_d.empty() ? "" : locate_map(obj_path, m, m.map_d, "map_d", warnings);
     const bool own_alpha = !mask_file.empty() && std::filesystem::path(mask_file).lexically_normal() ==
                                                      std::filesystem::path(file).lexically_normal();
-    TextureFileOptions options;
-    options.ignore_alpha = m.dissolve() >= 1.0 && !own_alpha;
-    options.srgb = !m.linear;
-    Texture texture;
-    try {
-        texture = load_texture(file, options);
-    } catch (const std::exception& e) {  // missing, unreadable, corrupt or too large
+    const auto unreadable = [&](const std::exception& e) {  // missing, unreadable, corrupt or too large
         warnings.push_back(where + "cannot load its map_Kd texture '" + file + "' (" + e.what() +
                            "); drawing the error texture instead");
-        return {error_texture(), false};
-    }
-    if (mask_file.empty() || own_alpha) return {texture, own_alpha};
-    try {
+        return MaterialTexture{error_texture(), false};
+    };
+    if (!mask_file.empty() && !own_alpha) {  // (each file read once)
         ImageReadOptions colour_options, mask_options;
         colour_options.srgb = !m.linear;
         colour_options.ignore_alpha = true;  // (the mask replaces it)
         mask_options.srgb = false;
-        return {masked_texture(read_image(file, colour_options), read_image(mask_file, mask_options),
-                               file + " (map_d " + mask_file + ")"),
-                true};
+        Image colour;
+        try {
+            colour = read_image(file, colour_options);
+        } catch (const std::exception& e) {
+            return unreadable(e);
+        }
+        try {
+            return {masked_texture(colour, read_image(mask_file, mask_options), file + " (map_d " + mask_file + ")"),
+                    true};
+        } catch (const std::exception& e) {
+            warnings.push_back(where + "cannot load its map_d mask '" + mask_file + "' (" + e.what() +
+                               "); drawn without it");
+        }
+    }
+    TextureFileOptions options;
+    options.ignore_alpha = m.dissolve() >= 1.0 && !own_alpha;
+    options.srgb = !m.linear;
+    try {
+        return {load_texture(file, options), own_alpha};
     } catch (const std::exception& e) {
-        warnings.push_back(where + "cannot load its map_d mask '" + mask_file + "' (" + e.what() +
-                           "); drawn without it");
-        return {texture, false};
+        return unreadable(e);
     }
 }
 

@@ -116,10 +116,10 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
     const auto test_and_write = [&](int px, int py, std::uint64_t samples, glm::vec4 c, const float* z) {
         if (!alpha_test(c, *draw.alpha_cutoff)) return;
         float* const color_px = target.color.at(px, py, 0);
+        float* const depth_px = kDepth != DepthFunc::none && draw.depth_write ? target.depth.at(px, py, 0) : nullptr;
         for (std::uint64_t m = samples; m; m &= m - 1) {
             const int s = __builtin_ctzll(m);
-            if constexpr (kDepth != DepthFunc::none)
-                if (draw.depth_write) target.depth.at(px, py, 0)[s] = z[s];
+            if (depth_px) depth_px[s] = z[s];
             blend_into<kBlend>(color_px + 4 * s, c);
         }
         if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
@@ -177,6 +177,7 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
             std::int64_t p[3];
             for (int i = 0; i < 3; ++i) p[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
             float z[kMaxSamples];
+            const float* const stored = kDepth != DepthFunc::none ? target.depth.at(px, py, 0) : nullptr;
             std::uint64_t passed = 0;
             for (int s = 0; s < S; ++s) {
                 const std::int64_t e0 = p[0] + off[0][s], e1 = p[1] + off[1][s], e2 = p[2] + off[2][s];
@@ -184,7 +185,7 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
                 ++counters.samples_covered;
                 if constexpr (kDepth != DepthFunc::none) {
                     z[s] = sample_depth(t, screen_weights(t, e0, e1, e2));
-                    if (!depth_passes<kDepth>(z[s], target.depth.at(px, py, 0)[s])) continue;
+                    if (!depth_passes<kDepth>(z[s], stored[s])) continue;
                 }
                 passed |= std::uint64_t{1} << s;
             }
