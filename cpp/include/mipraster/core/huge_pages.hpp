@@ -1,7 +1,7 @@
 #pragma once
-// Large per-render buffers on transparent huge pages: a buffer written once per render is
-// otherwise faulted in 4 KiB at a time (a million set-up triangles: ~110 MB, tens of thousands of
-// page faults, ~100 ms).
+// Large buffers on transparent huge pages: a buffer written once per render is otherwise faulted in
+// 4 KiB at a time (a million set-up triangles: ~110 MB, tens of thousands of page faults, ~100 ms),
+// and a large texture level read all over costs a TLB miss per 4 KiB page.
 #include <cstddef>
 #include <vector>
 

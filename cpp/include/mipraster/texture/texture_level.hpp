@@ -5,6 +5,8 @@
 
 #include <glm/vec4.hpp>
 
+#include "mipraster/core/huge_pages.hpp"
+
 namespace mipraster {
 
 /// Linear, premultiplied RGBA texels, row-major, row 0 at v = 0.
@@ -13,7 +15,13 @@ struct TextureLevel {
     std::vector<glm::vec4> texels;
 
     TextureLevel() = default;
-    TextureLevel(int w, int h) : width(w), height(h), texels(static_cast<std::size_t>(w) * static_cast<std::size_t>(h)) {}
+    // On huge pages where large: a bilinear quad's rows lie a whole texel row apart, and a line of
+    // anisotropic probes crosses many, each a 4 KiB page of its own without them (TLB misses).
+    TextureLevel(int w, int h) : width(w), height(h) {
+        const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+        reserve_on_huge_pages(texels, n);
+        texels.resize(n);
+    }
     const glm::vec4& at(int x, int y) const { return texels[static_cast<std::size_t>(y) * width + x]; }
     glm::vec4& at(int x, int y) { return texels[static_cast<std::size_t>(y) * width + x]; }
     std::size_t bytes() const { return texels.size() * sizeof(glm::vec4); }
