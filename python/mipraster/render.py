@@ -61,7 +61,8 @@ class RenderResult:
         stats: dict of the renderer's counters (``triangles_in``, ``triangles_clipped``,
             ``triangles_outside``, ``triangles_backface``, ``triangles_degenerate``,
             ``triangles_nonfinite``, ``triangles_rasterized``, ``samples_covered``,
-            ``samples_passed``, ``shader_invocations``, ``depth_blocks_rejected``, ``tiles_deferred``: tiles
+            ``samples_passed``: of those, the ones that passed the depth test and any alpha test (as an
+            OpenGL occlusion query counts), ``shader_invocations``, ``depth_blocks_rejected``, ``tiles_deferred``: tiles
             whose visible samples were shaded after a pre-pass, ``tiles_empty``: tiles no triangle
             reached, written from the clear values alone, ``threads``) and times in milliseconds
             (``transform_ms``, ``setup_ms``, ``raster_ms``, ``total_ms``).

@@ -125,6 +125,9 @@ void expect_mask_image(const MaskScene& scene, const mr::RenderResult& r, float 
             }
         }
     EXPECT_EQ(bad, 0) << what << ": samples that differ";
+    // Passed: the front quad's samples that survive the alpha test, then the back quad's where it
+    // discarded them; a discarded sample is not counted (as an OpenGL occlusion query).
+    EXPECT_EQ(r.stats.samples_passed, std::uint64_t{kW} * kH * fb.samples) << what;
     // The texture holds both kinds of pixel in numbers (not a vacuous pass).
     EXPECT_GT(kept, kW * kH / 4) << what;
     EXPECT_LT(kept, 3 * kW * kH / 4) << what;

@@ -68,6 +68,9 @@ def test_masked_quad_shows_what_is_behind_its_holes(spp, aa, cutoff):
         np.testing.assert_array_equal(result.samples[:, :, s], want, err_msg=f"sample {s}")
     # Depth: the front quad's (view depth 4.5) where it survived, the back quad's (5.5) in the holes.
     np.testing.assert_allclose(result.depth, np.where(shows_behind, 5.5, 4.5), rtol=1e-5)
+    # Every sample passes exactly once: the front quad's where it survives, the back quad's in the
+    # holes; a sample the alpha test discards is not counted (as an OpenGL occlusion query).
+    assert result.stats["samples_passed"] == W * H * spp
 
 
 def test_one_and_two_threads_agree_bit_for_bit():

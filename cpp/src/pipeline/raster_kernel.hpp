@@ -111,10 +111,11 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
         for (int i = 0; i < 3; ++i)
             off[i][s] = std::int64_t{t.edge_a[i]} * pattern.x[s] + std::int64_t{t.edge_b[i]} * pattern.y[s];
 
-    // Samples `samples` of pixel (px, py) with colour c: discarded, or their colour written and
-    // (depth_write) their depths z[s].
+    // Samples `samples` of pixel (px, py) with colour c: discarded, or counted as passed, their
+    // colour written and (depth_write) their depths z[s].
     const auto test_and_write = [&](int px, int py, std::uint64_t samples, glm::vec4 c, const float* z) {
         if (!alpha_test(c, *draw.alpha_cutoff)) return;
+        counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples));  // (as GL counts them)
         float* const color_px = target.color.at(px, py, 0);
         float* const depth_px = kDepth != DepthFunc::none && draw.depth_write ? target.depth.at(px, py, 0) : nullptr;
         for (std::uint64_t m = samples; m; m &= m - 1) {
@@ -157,7 +158,6 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
     };
     // Shades samples `samples` of pixel (px, py) at screen weights l (their depths z).
     const auto shade_samples = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l, const float* z) {
-        counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples));
         ++counters.shader_invocations;
         if (!sampler) {
             const glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, l, clip_weights, px, py);

@@ -112,7 +112,7 @@ struct TriangleBatch {
 
 struct TileCounters {
     std::uint64_t samples_covered = 0;  ///< samples inside a triangle
-    std::uint64_t samples_passed = 0;   ///< of those, passed the depth test
+    std::uint64_t samples_passed = 0;   ///< of those, passed the depth test (and any alpha test)
     std::uint64_t shader_invocations = 0;
     std::uint64_t depth_blocks_rejected = 0;  ///< (triangle, 8×8 block) pairs whose depth tests were skipped
     std::uint64_t tiles_deferred = 0;         ///< tiles shaded after a visibility pre-pass

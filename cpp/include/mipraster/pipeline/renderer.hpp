@@ -97,7 +97,8 @@ struct RenderStats {
     std::uint64_t triangles_nonfinite = 0; ///< non-finite after transform (e.g. a degenerate matrix): dropped
     std::uint64_t triangles_rasterized = 0;///< set-up (sub-)triangles sent to the rasterizer
     /// Samples inside a drawn triangle (whether or not their depth test ran: see
-    /// depth_blocks_rejected), of those the ones that passed the depth test, and colour shader runs.
+    /// depth_blocks_rejected), of those the ones that passed the depth test and were not discarded
+    /// by an alpha test (what an OpenGL occlusion query counts), and colour shader runs.
     std::uint64_t samples_covered = 0, samples_passed = 0, shader_invocations = 0;
     /// (triangle, 8×8-pixel block) pairs whose depth tests were skipped because the triangle lies
     /// behind every depth stored in the block (RenderSettings::block_skipping).
