@@ -161,8 +161,8 @@ class Scene:
                 premultiplied) is below it is discarded: it writes neither colour nor depth. One at
                 or above it is written opaque: rgb divided by its alpha, alpha 1 (then ``blend``
                 applies). Such a draw is shaded before its depth is written, sample by sample, and
-                a render with one is not deferred (about 1.1× the draw's time at one sample, 1.7×
-                under MSAA).
+                the tiles it reaches are not deferred (about 1.1× the draw's time at one sample,
+                1.7× under MSAA).
 
         Raises:
             TypeError: ``mesh`` is not a Mesh, a flag is not a bool, an option is not a string,

@@ -2,7 +2,8 @@
 // replaces, a visibility pre-pass and one shade per visible sample give the image of shading while
 // rasterizing, bit for bit — colour, depth and every counter but shader_invocations — for every
 // shading, texturing, depth setting, sample mode and thread count; the shader then runs exactly once
-// per sample that ends up drawn. Blending and MSAA renders are never deferred.
+// per sample that ends up drawn. MSAA renders are never deferred, nor tiles with a blended or
+// alpha-tested triangle.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "helpers.hpp"
@@ -209,6 +211,49 @@ TEST(DeferredShading, BlendingMsaaAndShallowScenesShadeWhileRasterizing) {
         EXPECT_EQ(o.deferred.stats.tiles_deferred, 0u);
         EXPECT_EQ(o.deferred.stats.shader_invocations, o.forward.stats.shader_invocations);
     }
+}
+
+TEST(DeferredShading, ABlendedOrAlphaTestedDrawKeepsOnlyItsOwnTilesFromBeingDeferred) {
+    // A deep textured scene over 3×3 tiles, and a small triangle near the camera, which it sees in
+    // the middle tile only: blended or alpha-tested, it stops that tile from being
+    // deferred (its shade decides what lies in front), and no other.
+    const int W = 96, H = 96;
+    const mr::Mesh deep = overlapping(200, 2.5, 71);
+    mr::Mesh small;
+    const glm::vec3 c(0.27f, 0.72f, 3.6f);  // on the line of sight, 0.43 from the camera (~6 px wide)
+    small.positions = {c + glm::vec3(-0.03f, -0.025f, 0.0f), c + glm::vec3(0.03f, -0.025f, 0.0f),
+                       c + glm::vec3(0.0f, 0.03f, 0.0f)};
+    small.triangles = {{0, 1, 2}};
+    const mr::Camera cam = overlap_camera(mr::DepthConvention::reverse_z, W, H);
+    mr::DrawState blended, alpha_tested;
+    blended.blend = mr::BlendMode::over;
+    alpha_tested.alpha_cutoff = 0.5f;
+    std::vector<mr::Draw> alone = {make_draw(deep, glm::dmat4(1.0), {})};
+    alone[0].texture = checker_texture();
+    const mr::RenderResult deep_only = mr::render(alone, cam, settings(W, H, 1));
+    ASSERT_EQ(deep_only.stats.tiles_deferred, 9u);  // every tile deep enough on its own
+    for (const auto& [name, state, colour] :
+         {std::tuple{"blended", blended, glm::vec4(0.4f, 0.1f, 0.1f, 0.5f)},
+          std::tuple{"alpha-tested, passing", alpha_tested, glm::vec4(0.9f, 0.2f, 0.1f, 0.75f)},
+          std::tuple{"alpha-tested, discarded", alpha_tested, glm::vec4(0.9f, 0.2f, 0.1f, 0.25f)}})
+        for (bool on_top : {false, true})
+            for (int samples : {1, 4}) {
+                SCOPED_TRACE(std::string(name) + (on_top ? ", no depth test" : "") + ", " + std::to_string(samples) +
+                             " samples");
+                mr::DrawState st = state;
+                st.depth_test = !on_top;  // on top: drawn over the deep scene wherever it lies
+                std::vector<mr::Draw> draws = alone;
+                draws.push_back(make_draw(small, glm::dmat4(1.0), st, colour));
+                const Outcome o = render_both(draws, cam, settings(W, H, samples));
+                expect_same_image(o);
+                EXPECT_EQ(o.deferred.stats.tiles_deferred, 8u);
+                // Drawn on top, the small triangle changed the middle tile's pixels (depth-tested, the
+                // deep scene's triangles that cross the near plane may hide it).
+                if (on_top && std::string(name) != "alpha-tested, discarded") {
+                    const mr::RenderResult without = mr::render(alone, cam, settings(W, H, samples));
+                    EXPECT_FALSE(same_bits(o.deferred.color.pixels, without.color.pixels));
+                }
+            }
 }
 
 // A random triangle of about `size` pixels around a random point of an N×N screen (its vertices

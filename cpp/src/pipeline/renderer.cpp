@@ -294,13 +294,23 @@ double tile_overdraw(std::size_t tile, const std::vector<BinnedChunk>& chunks, c
     return area / (double(target.x1 - target.x0) * double(target.y1 - target.y0));
 }
 
+// Whether the tile may be deferred: every triangle in it is of a draw that may (`deferrable`).
+bool tile_deferrable(std::size_t tile, const std::vector<BinnedChunk>& chunks, const std::vector<char>& deferrable) {
+    for (const BinnedChunk& chunk : chunks)
+        for (std::uint32_t i = chunk.tile_start[tile]; i < chunk.tile_start[tile + 1]; ++i)
+            if (!deferrable[chunk.triangles[chunk.tile_triangles[i]].draw]) return false;
+    return true;
+}
+
 // Whether deferring the tile's shading pays (with RenderSettings::deferred_shading): overdraw
 // from kDeferredMinOverdraw on, and for a tile without textures also big enough triangles
-// (kDeferredMinUntexturedGain).
+// (kDeferredMinUntexturedGain). `deferrable`: per draw, whether it may be deferred; every_draw:
+// all may (else the tile's triangles are checked).
 bool defer_tile(std::size_t tile, const std::vector<BinnedChunk>& chunks, const std::vector<DrawInputs>& inputs,
-                const TileTarget& target) {
+                const std::vector<char>& deferrable, bool every_draw, const TileTarget& target) {
     const double overdraw = tile_overdraw(tile, chunks, target);
     if (overdraw < kDeferredMinOverdraw) return false;
+    if (!every_draw && !tile_deferrable(tile, chunks, deferrable)) return false;
     std::size_t triangles = 0;
     for (const BinnedChunk& chunk : chunks) {
         const std::uint32_t first = chunk.tile_start[tile], count = chunk.tile_start[tile + 1] - first;
@@ -496,7 +506,11 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     // Each draw's kernels (which also say whether deferred shading may run) and inputs.
     std::vector<TileKernel> kernels(draws.size()), prepass_kernels(draws.size());
     std::vector<OwnedShadingKernel> shading_kernels(draws.size());
-    bool deferred = settings.deferred_shading;  // every draw has a deferred shading pass
+    // Per draw, whether its tiles may be deferred: it has a deferred shading pass and no alpha test
+    // (its samples keep the depth of what lies behind wherever its shade is discarded: the
+    // pre-pass, which shades nothing, cannot know which triangle a sample ends up with). A tile
+    // is deferred only when all its triangles' draws may be.
+    std::vector<char> deferrable(draws.size());
     std::vector<DrawInputs> inputs(draws.size());
     std::vector<std::unique_ptr<TextureView>> textures(draws.size());  // pinned for the render
     for (std::size_t d = 0; d < draws.size(); ++d) {
@@ -509,9 +523,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         prepass.shading = Shading::visibility;
         prepass_kernels[d] = select_tile_kernel(prepass);
         shading_kernels[d] = select_owned_shading_kernel(key);
-        // An alpha-tested draw's samples keep the depth of what lies behind wherever its shade is
-        // discarded: the pre-pass, which shades nothing, cannot know which triangle a sample ends up with.
-        deferred = deferred && shading_kernels[d] && !draws[d].state.alpha_cutoff;
+        deferrable[d] = settings.deferred_shading && shading_kernels[d] && !draws[d].state.alpha_cutoff;
         const Mesh& mesh = *draws[d].mesh;
         inputs[d] = {mesh.triangles.data(), mesh.has_colors() ? mesh.colors.data() : nullptr, draws[d].color,
                      draws[d].state.depth_write, draws[d].state.alpha_cutoff};
@@ -528,6 +540,10 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 inputs[d].footprint_scale = glm::dvec2(1.0 / result.pattern.columns, 1.0 / result.pattern.rows);
         }
     }
+
+    // Whether some tile may be deferred, and whether every one may (else defer_tile looks).
+    const bool deferred = std::find(deferrable.begin(), deferrable.end(), 1) != deferrable.end();
+    const bool every_draw_deferrable = std::find(deferrable.begin(), deferrable.end(), 0) == deferrable.end();
 
     // Stage 2: clip, set up and bin (with the per-tile overlap estimate only where a tile may be
     // deferred).
@@ -640,7 +656,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 target.color.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
                 if (needs_depth) target.depth.fill(target.x0, target.y0, target.x1, target.y1, clear_depth4);
             }
-            if (deferred && defer_tile(tile, chunks, inputs, target))
+            if (deferred && defer_tile(tile, chunks, inputs, deferrable, every_draw_deferrable, target))
                 rasterize_tile_deferred(tile, chunks, prepass_kernels, shading_kernels, inputs, target, counters);
             else
                 rasterize_tile_chunks(tile, chunks, kernels, inputs, target, counters);
