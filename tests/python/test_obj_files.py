@@ -279,7 +279,7 @@ def test_map_d_under_a_dissolve_blends_instead(tmp_path):
 
 @pytest.mark.parametrize("statements, note", [
     ("map_Kd checker.png\nmap_d missing.png", "missing.png': no such file); drawn without it"),
-    ("map_d mask.png", "map_d without map_Kd is not supported"),
+    ("map_d missing.png", "missing.png': no such file); drawn without it"),
     ("map_Kd checker.png\nmap_d", "map_d names no file"),
 ])
 def test_map_d_that_cannot_be_used_warns_and_draws_without_it(tmp_path, statements, note):
@@ -289,6 +289,24 @@ def test_map_d_that_cannot_be_used_warns_and_draws_without_it(tmp_path, statemen
     assert scene.draws[0].alpha_cutoff is None
     color = render(scene, 2)
     assert not np.any(np.all(color == BEHIND, axis=-1))  # no holes
+
+
+def test_map_d_without_map_kd_masks_the_kd_colour(tmp_path):
+    # A mask alone: the material's Kd where the mask keeps the quad (a white texture times Kd,
+    # opaque), what lies behind elsewhere.
+    Image.fromarray(np.round(MASK * 255).astype(np.uint8), "L").save(tmp_path / "mask.png")
+    (tmp_path / "m.mtl").write_text("newmtl tex\nKd 0.2 0.6 0.9\nmap_d mask.png\n")
+    (tmp_path / "s.obj").write_text(obj_text())
+    scene, messages = load_quiet(tmp_path / "s.obj")
+    scene.add(mr.Mesh(QUAD_V - [0, 0, 1], [[0, 1, 2], [0, 2, 3]]), color=BEHIND)
+    assert messages == []
+    d = scene.draws[0]
+    assert d.alpha_cutoff == 0.5 and d.blend == "replace"
+    np.testing.assert_allclose(d.texture.level(0)[..., 3], np.round(MASK * 255) / 255, atol=1e-6)
+    kd = np.float32([0.2, 0.6, 0.9, 1.0])
+    for q, m in enumerate(MASK.reshape(4)):
+        np.testing.assert_allclose(quadrants(render(scene, 2))[q], kd if m >= 0.5 else BEHIND, atol=1e-6,
+                                   err_msg=f"quadrant {q}")
 
 
 def test_map_d_options_that_would_move_the_mask_warn(tmp_path):

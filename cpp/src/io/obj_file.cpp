@@ -602,9 +602,8 @@ std::vector<ObjMaterial> read_materials(const std::string& obj_path, const ObjSo
         if (m.dissolve() == 0.0)
             warnings.push_back(where + "fully transparent (" + (m.has_d ? "d 0" : "Tr 1") +
                                "); its faces are invisible");
-        // The mask is read at map_Kd's uvs, into map_Kd's texture (map_kd_texture).
-        if (!m.map_d.empty() && m.map_kd.empty())
-            warnings.push_back(where + "map_d without map_Kd is not supported; drawn without the alpha mask");
+        // The mask is read at map_Kd's uvs, into map_Kd's texture, or alone into a white one
+        // (map_kd_texture).
         materials.push_back(std::move(m));
     }
     return materials;
@@ -700,7 +699,7 @@ std::string locate_map(const std::string& obj_path, const ObjMaterial& m, const 
     return file;
 }
 
-/// A material's texture, and whether its alpha is a map_d mask.
+/// A material's texture (map_Kd, or white under a map_d alone), and whether its alpha is a map_d mask.
 struct MaterialTexture {
     Texture texture;
     bool masked = false;
@@ -731,9 +730,26 @@ Texture masked_texture(const Image& colour, const Image& mask, const std::string
 /// alphaMode BLEND; a missing or unreadable file becomes the error texture with a warning. With a
 /// map_d (an alpha mask), the texture's alpha is the mask instead: map_Kd's own alpha when map_d
 /// names the same file, else masked_texture; a mask that cannot be read is a warning, and the
-/// material is drawn without it.
+/// material is drawn without it. A map_d without a map_Kd masks a white texture (the material's Kd
+/// colour shows where the mask keeps it); without the mask, the texture is plain white.
 MaterialTexture map_kd_texture(const std::string& obj_path, const ObjMaterial& m, std::vector<std::string>& warnings) {
     const std::string where = m.mtl_path + ": material '" + m.name + "': ";
+    if (m.map_kd.empty()) {
+        const std::string mask_file = locate_map(obj_path, m, m.map_d, "map_d", warnings);
+        ImageReadOptions mask_options;
+        mask_options.srgb = false;
+        try {
+            const Image mask = read_image(mask_file, mask_options);
+            Image white = Image::unfilled(mask.width, mask.height, 4);
+            std::fill(white.pixels.begin(), white.pixels.end(), 1.0f);
+            return {masked_texture(white, mask, "map_d " + mask_file), true};
+        } catch (const std::exception& e) {
+            warnings.push_back(where + "cannot load its map_d mask '" + mask_file + "' (" + e.what() +
+                               "); drawn without it");
+            const float white[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+            return {Texture::from_float(white, 1, 1, 4, /*premultiplied=*/true, "white"), false};
+        }
+    }
     const std::string file = locate_map(obj_path, m, m.map_kd, "map_Kd", warnings);
     const std::string mask_file = m.map_d.empty() ? "" : locate_map(obj_path, m, m.map_d, "map_d", warnings);
     const bool own_alpha = !mask_file.empty() && std::filesystem::path(mask_file).lexically_normal() ==
@@ -815,7 +831,9 @@ LoadedScene load_obj(const std::string& path) {
     auto material_name = [&](int material) {
         return material < 0 ? std::string("default material") : "material '" + materials[material].name + "'";
     };
-    auto is_textured = [&](int material) { return material >= 0 && !materials[material].map_kd.empty(); };
+    auto is_textured = [&](int material) {  // (a map_d alone masks a white texture)
+        return material >= 0 && (!materials[material].map_kd.empty() || !materials[material].map_d.empty());
+    };
 
     // Step 1: triangulate the faces and gather their triangles per (material, textured) in order
     // of first use. A textured material's faces without texture coordinates go to its untextured
@@ -887,8 +905,8 @@ LoadedScene load_obj(const std::string& path) {
         const bool keep_normals = g.all_normals;
         if (is_textured(g.material) && !g.textured)
             scene.warnings.push_back(path + ": " + name + ": " + std::to_string(g.triangles.size()) +
-                                     " triangle(s) have no texture coordinates; they are drawn without its map_Kd "
-                                     "texture");
+                                     " triangle(s) have no texture coordinates; they are drawn without its " +
+                                     (materials[g.material].map_kd.empty() ? "map_d mask" : "map_Kd texture"));
 
         // The material's map_Kd -s / -o scale and offset the uvs (an affine map, exact per vertex).
         glm::vec2 uv_scale(1.0f), uv_offset(0.0f);
