@@ -14,6 +14,7 @@
 #include <pybind11/stl.h>
 
 #include "common.hpp"
+#include "mipraster/core/huge_pages.hpp"
 #include "mipraster/pipeline/draw.hpp"
 #include "mipraster/scene/camera.hpp"
 #include "mipraster/scene/demo_scene.hpp"
@@ -34,7 +35,9 @@ static_assert(sizeof(glm::vec2) == 2 * sizeof(float), "glm::vec2 must be 2 packe
 template <class Vec, class T>
 std::vector<Vec> copy_rows(const CArray<T>& a, py::ssize_t columns, const char* name) {
     require_shape(a, {-1, columns}, name);
-    std::vector<Vec> rows(static_cast<std::size_t>(a.shape(0)));
+    std::vector<Vec> rows;
+    reserve_on_huge_pages(rows, static_cast<std::size_t>(a.shape(0)));  // (read per triangle, all over)
+    rows.resize(static_cast<std::size_t>(a.shape(0)));
     if (!rows.empty()) std::memcpy(rows.data(), a.data(), sizeof(Vec) * rows.size());
     return rows;
 }
