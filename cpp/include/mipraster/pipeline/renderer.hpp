@@ -68,10 +68,10 @@ struct RenderSettings {
     /// comparison.
     bool sample_rows = true;
     /// Where a tile's triangles overlap kDeferredMinOverdraw deep or more and every one of them is
-    /// of a draw that replaces without an alpha test (at 1 sample or SSAA), shade only the samples that stay visible: a pre-pass
-    /// records which triangle each sample ends up with, then each sample is shaded once. The
-    /// image is the same bit for bit, and so are the counters but shader_invocations; false
-    /// always shades while rasterizing, for comparison.
+    /// of a draw that replaces without an alpha test (at 1 sample or SSAA), shade only the samples
+    /// that stay visible: a pre-pass records which triangle each sample ends up with, then each
+    /// sample is shaded once. The image is the same bit for bit, and so are the counters but
+    /// shader_invocations; false always shades while rasterizing, for comparison.
     bool deferred_shading = true;
     /// Textured draws look their texture up sixteen samples at a time in float vectors where the
     /// sampler allows (BatchSampler: bilinear or trilinear, repeat or clamp), each value within
