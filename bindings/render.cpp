@@ -191,7 +191,8 @@ void bind_render(py::module_& m) {
             [](RenderSettings& s, const std::string& name) { s.resolve_filter = parse_resolve_filter(name); },
             "reconstruction filter of the resolve: 'box', 'tent', 'mitchell', 'catmull-rom' or 'lanczos3'")
         .def_readwrite("deferred_shading", &RenderSettings::deferred_shading,
-                       "where triangles overlap deeply and every draw replaces, shade only visible samples")
+                       "where a tile's triangles overlap deeply and all replace without an alpha test, shade only "
+                       "visible samples")
         .def_readwrite("batched_lookups", &RenderSettings::batched_lookups,
                        "look textures up sixteen samples at a time in float (within batch_sampling_tolerance of "
                        "the double-precision reference); False: the reference for every sample")
