@@ -734,26 +734,11 @@ Texture masked_texture(const Image& colour, const Image& mask, const std::string
 /// colour shows where the mask keeps it); without the mask, the texture is plain white.
 MaterialTexture map_kd_texture(const std::string& obj_path, const ObjMaterial& m, std::vector<std::string>& warnings) {
     const std::string where = m.mtl_path + ": material '" + m.name + "': ";
-    if (m.map_kd.empty()) {
-        const std::string mask_file = locate_map(obj_path, m, m.map_d, "map_d", warnings);
-        ImageReadOptions mask_options;
-        mask_options.srgb = false;
-        try {
-            const Image mask = read_image(mask_file, mask_options);
-            Image white = Image::unfilled(mask.width, mask.height, 4);
-            std::fill(white.pixels.begin(), white.pixels.end(), 1.0f);
-            return {masked_texture(white, mask, "map_d " + mask_file), true};
-        } catch (const std::exception& e) {
-            warnings.push_back(where + "cannot load its map_d mask '" + mask_file + "' (" + e.what() +
-                               "); drawn without it");
-            const float white[4] = {1.0f, 1.0f, 1.0f, 1.0f};
-            return {Texture::from_float(white, 1, 1, 4, /*premultiplied=*/true, "white"), false};
-        }
-    }
-    const std::string file = locate_map(obj_path, m, m.map_kd, "map_Kd", warnings);
+    const std::string file = m.map_kd.empty() ? "" : locate_map(obj_path, m, m.map_kd, "map_Kd", warnings);
     const std::string mask_file = m.map_d.empty() ? "" : locate_map(obj_path, m, m.map_d, "map_d", warnings);
-    const bool own_alpha = !mask_file.empty() && std::filesystem::path(mask_file).lexically_normal() ==
-                                                     std::filesystem::path(file).lexically_normal();
+    const bool own_alpha = !file.empty() && !mask_file.empty() &&
+                           std::filesystem::path(mask_file).lexically_normal() ==
+                               std::filesystem::path(file).lexically_normal();
     const auto unreadable = [&](const std::exception& e) {  // missing, unreadable, corrupt or too large
         warnings.push_back(where + "cannot load its map_Kd texture '" + file + "' (" + e.what() +
                            "); drawing the error texture instead");
@@ -765,18 +750,29 @@ MaterialTexture map_kd_texture(const std::string& obj_path, const ObjMaterial& m
         colour_options.ignore_alpha = true;  // (the mask replaces it)
         mask_options.srgb = false;
         Image colour;
-        try {
-            colour = read_image(file, colour_options);
-        } catch (const std::exception& e) {
-            return unreadable(e);
+        if (!file.empty()) {
+            try {
+                colour = read_image(file, colour_options);
+            } catch (const std::exception& e) {
+                return unreadable(e);
+            }
         }
         try {
-            return {masked_texture(colour, read_image(mask_file, mask_options), file + " (map_d " + mask_file + ")"),
+            const Image mask = read_image(mask_file, mask_options);
+            if (file.empty()) {  // a map_d alone masks white, at the mask's size
+                colour = Image::unfilled(mask.width, mask.height, 4);
+                std::fill(colour.pixels.begin(), colour.pixels.end(), 1.0f);
+            }
+            return {masked_texture(colour, mask, (file.empty() ? "" : file + " ") + "(map_d " + mask_file + ")"),
                     true};
         } catch (const std::exception& e) {
             warnings.push_back(where + "cannot load its map_d mask '" + mask_file + "' (" + e.what() +
                                "); drawn without it");
         }
+    }
+    if (file.empty()) {  // a map_d alone whose mask cannot be read: the Kd colour, unmasked
+        const float white[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+        return {Texture::from_float(white, 1, 1, 4, /*premultiplied=*/true, "white"), false};
     }
     TextureFileOptions options;
     options.ignore_alpha = m.dissolve() >= 1.0 && !own_alpha;

@@ -76,12 +76,16 @@ void shade_row_colours(float* target, int stride, std::uint32_t passed, const do
     }
 }
 
-// True when a draw's texture lookups go through a lookup queue (debug views never do, nor
-// alpha-tested draws: the queue shades after the depth writes).
+// True when a draw's texture lookups go through the BatchSampler (debug views never do): the lookup
+// queue's, or for an alpha-tested draw alpha_tested_triangle's (the queue shades after the depth
+// writes).
+template <Texturing kTexturing>
+inline bool batches_lookups(const DrawInputs& draw) {
+    return kTexturing != Texturing::none && draw.batched_lookups && draw.debug_view == DebugView::none;
+}
 template <Texturing kTexturing>
 inline bool queues_lookups(const DrawInputs& draw) {
-    return kTexturing != Texturing::none && draw.batched_lookups && draw.debug_view == DebugView::none &&
-           !draw.alpha_cutoff;
+    return batches_lookups<kTexturing>(draw) && !draw.alpha_cutoff;
 }
 
 // Triangle t of an alpha-tested draw (DrawInputs::alpha_cutoff) over pixels [x0, x1) × [y0, y1) of
@@ -228,9 +232,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     // An alpha-tested draw's batched lookups (alpha_tested_triangle), where a draw without a cutoff
     // would queue them.
     std::optional<BatchSampler> alpha_sampler;
-    if (kTexturing != Texturing::none && draw.alpha_cutoff && draw.batched_lookups &&
-        draw.debug_view == DebugView::none)
-        alpha_sampler.emplace(*draw.texture, *draw.sampler);
+    if (batches_lookups<kTexturing>(draw) && draw.alpha_cutoff) alpha_sampler.emplace(*draw.texture, *draw.sampler);
 
     for (std::size_t k = 0; k < batch.count; ++k) {
         const SetupTriangle& t = batch.tris[batch.indices[k]];

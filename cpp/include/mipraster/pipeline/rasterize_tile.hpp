@@ -83,7 +83,7 @@ struct DrawInputs {
     bool depth_write;
     /// DrawState::alpha_cutoff. When set, the kernel shades before it writes depth: each triangle
     /// takes alpha_tested_triangle (not the sample rows, MSAA's pixel vectors or the lookup queue,
-    /// which write depth before the colour is known), and a draw with it cannot be deferred.
+    /// which write depth before the colour is known), and no tile it reaches is deferred.
     std::optional<float> alpha_cutoff = std::nullopt;
     // Texturing only:
     const glm::vec2* uvs = nullptr;
