@@ -291,11 +291,18 @@ def test_map_d_that_cannot_be_used_warns_and_draws_without_it(tmp_path, statemen
     assert not np.any(np.all(color == BEHIND, axis=-1))  # no holes
 
 
-def test_map_d_without_map_kd_masks_the_kd_colour(tmp_path):
-    # A mask alone: the material's Kd where the mask keeps the quad (a white texture times Kd,
-    # opaque), what lies behind elsewhere.
+# Placement options of a map and the columns of a 2x2 image that the 2x2 render's pixel columns then
+# read: -o 0.5 swaps them (u + 0.5, repeated); with -clamp on both read the right one (u 0.75 and
+# 1.25, clamped).
+PLACEMENTS = [("", [0, 1]), ("-o 0.5 0 ", [1, 0]), ("-clamp on -o 0.5 0 ", [1, 1])]
+
+
+@pytest.mark.parametrize("options, columns", PLACEMENTS)
+def test_map_d_without_map_kd_masks_the_kd_colour(tmp_path, options, columns):
+    # A mask alone, placed by its own options: the material's Kd where the mask keeps the quad (a white
+    # texture times Kd, opaque), what lies behind elsewhere.
     Image.fromarray(np.round(MASK * 255).astype(np.uint8), "L").save(tmp_path / "mask.png")
-    (tmp_path / "m.mtl").write_text("newmtl tex\nKd 0.2 0.6 0.9\nmap_d mask.png\n")
+    (tmp_path / "m.mtl").write_text(f"newmtl tex\nKd 0.2 0.6 0.9\nmap_d {options}mask.png\n")
     (tmp_path / "s.obj").write_text(obj_text())
     scene, messages = load_quiet(tmp_path / "s.obj")
     scene.add(mr.Mesh(QUAD_V - [0, 0, 1], [[0, 1, 2], [0, 2, 3]]), color=BEHIND)
@@ -304,15 +311,34 @@ def test_map_d_without_map_kd_masks_the_kd_colour(tmp_path):
     assert d.alpha_cutoff == 0.5 and d.blend == "replace"
     np.testing.assert_allclose(d.texture.level(0)[..., 3], np.round(MASK * 255) / 255, atol=1e-6)
     kd = np.float32([0.2, 0.6, 0.9, 1.0])
-    for q, m in enumerate(MASK.reshape(4)):
+    for q, m in enumerate(MASK[:, columns].reshape(4)):
         np.testing.assert_allclose(quadrants(render(scene, 2))[q], kd if m >= 0.5 else BEHIND, atol=1e-6,
                                    err_msg=f"quadrant {q}")
 
 
-def test_map_d_options_that_would_move_the_mask_warn(tmp_path):
+@pytest.mark.parametrize("options, columns", PLACEMENTS)
+def test_map_d_placed_as_map_kd_moves_with_it(tmp_path, options, columns):
+    # map_Kd and map_d with the same placement (as exporters write them): texture and mask move together.
+    Image.fromarray(np.round(MASK * 255).astype(np.uint8), "L").save(tmp_path / "mask.png")
+    scene, messages = masked_obj(tmp_path, f"map_Kd {options}checker.png\nmap_d {options}mask.png")
+    assert messages == []
+    color = render(scene, 2)
+    for q, (texel, m) in enumerate(zip(TEXELS[:, columns].reshape(4, 4), MASK[:, columns].reshape(4))):
+        np.testing.assert_allclose(quadrants(color)[q], texel if m >= 0.5 else BEHIND, atol=1e-6,
+                                   err_msg=f"quadrant {q}")
+
+
+def test_map_d_options_that_would_move_the_mask_off_map_kd_warn(tmp_path):
     Image.fromarray(np.round(MASK * 255).astype(np.uint8), "L").save(tmp_path / "mask.png")
     scene, messages = masked_obj(tmp_path, "map_Kd checker.png\nmap_d -imfchan l -s 2 2 1 mask.png")
-    assert len(messages) == 1 and "map_d option -s is ignored" in messages[0], messages
+    assert len(messages) == 1 and "map_d's -s, -o or -clamp differ from map_Kd's" in messages[0], messages
+    expect_masked(render(scene, 2), MASK)
+
+
+def test_map_d_options_that_change_the_look_warn(tmp_path):
+    Image.fromarray(np.round(MASK * 255).astype(np.uint8), "L").save(tmp_path / "mask.png")
+    scene, messages = masked_obj(tmp_path, "map_Kd checker.png\nmap_d -mm 0.2 1 -t 0 0 0 mask.png")
+    assert len(messages) == 1 and "map_d option -mm is not supported" in messages[0], messages
     expect_masked(render(scene, 2), MASK)
 
 

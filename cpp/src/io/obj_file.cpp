@@ -408,6 +408,13 @@ std::vector<std::string> mtl_files(const std::string& obj_path, std::size_t line
 
 // --- MTL -------------------------------------------------------------------------------------
 
+/// Where a map statement places its image on the uvs: -s and -o (u and v), -clamp.
+struct MapPlacement {
+    glm::vec2 scale{1.0f}, offset{0.0f};
+    bool clamp = false;
+    bool operator==(const MapPlacement& o) const { return scale == o.scale && offset == o.offset && clamp == o.clamp; }
+};
+
 /// A material of an MTL file, as the loader draws it.
 struct ObjMaterial {
     std::string name, mtl_path;  ///< its name and the MTL file defining it (map_Kd is relative to it)
@@ -417,8 +424,9 @@ struct ObjMaterial {
     bool has_d = false, has_tr = false;
     std::string map_kd;                          ///< the map_Kd file as written; empty: none
     std::string map_d;                           ///< the map_d file (an alpha mask) as written; empty: none
-    glm::vec2 uv_scale{1.0f}, uv_offset{0.0f};   ///< map_Kd -s and -o (u and v)
-    bool clamp = false, linear = false;          ///< map_Kd -clamp on, -colorspace linear
+    MapPlacement placement;                      ///< map_Kd's, or a map_d's without a map_Kd
+    MapPlacement d_placement;                    ///< map_d's as written
+    bool linear = false;                         ///< map_Kd -colorspace linear
 
     /// The opacity: d, else 1 − Tr, else 1.
     double dissolve() const { return has_d ? d : has_tr ? 1.0 - tr : 1.0; }
@@ -469,6 +477,27 @@ std::string parse_map_statement(std::string_view rest, const std::string& keywor
     return std::string(rest);
 }
 
+/// Applies map option -s, -o (u and v; w ignored) or -clamp to `p`; false for any other option.
+bool place_map(std::string_view option, const std::vector<double>& numbers, const std::string& word, MapPlacement& p) {
+    if (option == "-s" || option == "-o") {
+        glm::vec2& v = option == "-s" ? p.scale : p.offset;
+        for (std::size_t i = 0; i < numbers.size() && i < 2; ++i)
+            v[static_cast<int>(i)] = static_cast<float>(numbers[i]);
+    } else if (option == "-clamp") {
+        p.clamp = word == "on";
+    } else {
+        return false;
+    }
+    return true;
+}
+
+/// Whether map option -mm, -t or -cc, which this renderer does not apply, would change the look.
+bool changes_look(std::string_view option, const std::vector<double>& numbers, const std::string& word) {
+    return (option == "-mm" && !numbers.empty() && (numbers[0] != 0.0 || (numbers.size() > 1 && numbers[1] != 1.0))) ||
+           (option == "-t" && std::any_of(numbers.begin(), numbers.end(), [](double x) { return x != 0.0; })) ||
+           (option == "-cc" && word == "on");
+}
+
 /// Parses "map_Kd [options] file". Options this renderer applies: -s and -o (u, v; w ignored),
 /// -clamp and -colorspace. Those that change the look but are not applied (-mm, -t, -cc on) are
 /// warned about; those without meaning for a colour map here (-bm, -blendu, -blendv, -boost,
@@ -478,35 +507,26 @@ void parse_map_kd(std::string_view rest, ObjMaterial& m, const std::function<voi
     m.map_kd = parse_map_statement(rest, "map_Kd", bad, warn, [&](std::string_view option,
                                                                   const std::vector<double>& numbers,
                                                                   const std::string& word) {
-        if (option == "-s" || option == "-o") {
-            glm::vec2& v = option == "-s" ? m.uv_scale : m.uv_offset;
-            for (std::size_t i = 0; i < numbers.size() && i < 2; ++i)
-                v[static_cast<int>(i)] = static_cast<float>(numbers[i]);
-        } else if (option == "-clamp") {
-            m.clamp = word == "on";
-        } else if (option == "-colorspace") {
-            m.linear = word == "linear";
-        } else if ((option == "-mm" && !numbers.empty() &&
-                    (numbers[0] != 0.0 || (numbers.size() > 1 && numbers[1] != 1.0))) ||
-                   (option == "-t" && std::any_of(numbers.begin(), numbers.end(), [](double x) { return x != 0.0; })) ||
-                   (option == "-cc" && word == "on")) {
+        if (place_map(option, numbers, word, m.placement)) return;
+        if (option == "-colorspace") m.linear = word == "linear";
+        else if (changes_look(option, numbers, word))
             warn("map_Kd option " + std::string(option) + " is not supported; the texture is drawn without it");
-        }
     });
     if (m.map_kd.empty()) warn("map_Kd names no file; drawn without a texture");
 }
 
-/// Parses "map_d [options] file": the mask is read at map_Kd's uvs (its -s, -o and -clamp), so
-/// options that would move it apart (-s, -o, -clamp, -mm, -t, -cc) are warned about and ignored;
-/// -imfchan, -texres, -boost, -bm, -blendu/v, -type and -colorspace are skipped quietly (the mask is the
-/// file's alpha, or its first channel when it has no alpha).
+/// Parses "map_d [options] file". Its -s, -o and -clamp place the mask when there is no map_Kd;
+/// with one, the mask is read at map_Kd's uvs (read_materials warns when they differ). -mm, -t and
+/// -cc that would change the look are warned about; -imfchan, -texres, -boost, -bm, -blendu/v,
+/// -type and -colorspace are skipped quietly (the mask is the file's alpha, or its first channel
+/// when it has no alpha).
 void parse_map_d(std::string_view rest, ObjMaterial& m, const std::function<void(const std::string&)>& bad,
                  const std::function<void(const std::string&)>& warn) {
-    m.map_d = parse_map_statement(rest, "map_d", bad, warn, [&](std::string_view option, const std::vector<double>&,
-                                                                const std::string&) {
-        if (option == "-s" || option == "-o" || option == "-clamp" || option == "-mm" || option == "-t" ||
-            option == "-cc")
-            warn("map_d option " + std::string(option) + " is ignored; the mask is read at map_Kd's uvs");
+    m.map_d = parse_map_statement(rest, "map_d", bad, warn, [&](std::string_view option,
+                                                                const std::vector<double>& numbers,
+                                                                const std::string& word) {
+        if (!place_map(option, numbers, word, m.d_placement) && changes_look(option, numbers, word))
+            warn("map_d option " + std::string(option) + " is not supported; the mask is drawn without it");
     });
     if (m.map_d.empty()) warn("map_d names no file; drawn without an alpha mask");
 }
@@ -602,8 +622,14 @@ std::vector<ObjMaterial> read_materials(const std::string& obj_path, const ObjSo
         if (m.dissolve() == 0.0)
             warnings.push_back(where + "fully transparent (" + (m.has_d ? "d 0" : "Tr 1") +
                                "); its faces are invisible");
-        // The mask is read at map_Kd's uvs, into map_Kd's texture, or alone into a white one
-        // (map_kd_texture).
+        // The mask is read at map_Kd's uvs, into map_Kd's texture, or alone (at its own) into a
+        // white one (map_kd_texture).
+        if (!m.map_d.empty() && m.map_kd.empty()) {
+            m.placement = m.d_placement;
+        } else if (!m.map_d.empty() && !(m.d_placement == m.placement)) {
+            warnings.push_back(where + "map_d's -s, -o or -clamp differ from map_Kd's; they are ignored, the "
+                                       "mask is read at map_Kd's uvs");
+        }
         materials.push_back(std::move(m));
     }
     return materials;
@@ -904,12 +930,10 @@ LoadedScene load_obj(const std::string& path) {
                                      " triangle(s) have no texture coordinates; they are drawn without its " +
                                      (materials[g.material].map_kd.empty() ? "map_d mask" : "map_Kd texture"));
 
-        // The material's map_Kd -s / -o scale and offset the uvs (an affine map, exact per vertex).
-        glm::vec2 uv_scale(1.0f), uv_offset(0.0f);
-        if (g.textured) {
-            uv_scale = materials[g.material].uv_scale;
-            uv_offset = materials[g.material].uv_offset;
-        }
+        // The material's -s / -o (map_Kd's, or a map_d's alone) scale and offset the uvs (an affine
+        // map, exact per vertex).
+        MapPlacement placement;
+        if (g.textured) placement = materials[g.material].placement;
 
         auto mesh = std::make_shared<Mesh>();
         std::unordered_map<ObjCorner, std::uint32_t, ObjCornerHash> remap;
@@ -929,7 +953,7 @@ LoadedScene load_obj(const std::string& path) {
                     if (keep_uvs) {
                         const std::size_t i = static_cast<std::size_t>(key.t);
                         const glm::vec2 vt(attrib.texcoords[2 * i], attrib.texcoords[2 * i + 1]);
-                        const glm::vec2 uv = vt * uv_scale + uv_offset;
+                        const glm::vec2 uv = vt * placement.scale + placement.offset;
                         mesh->uvs.emplace_back(uv.x, 1.0f - uv.y);  // OBJ's v runs up the image, ours down
                     }
                     if (keep_normals) {
@@ -964,7 +988,7 @@ LoadedScene load_obj(const std::string& path) {
             // A map_d mask: alpha-tested as glTF's MASK, or, under a dissolve, blended with it.
             if (it->second.masked && draw.state.blend == BlendMode::replace)
                 draw.state.alpha_cutoff = kDefaultAlphaCutoff;
-            if (materials[g.material].clamp) draw.sampler.wrap_u = draw.sampler.wrap_v = WrapMode::clamp;
+            if (materials[g.material].placement.clamp) draw.sampler.wrap_u = draw.sampler.wrap_v = WrapMode::clamp;
         }
         scene.meshes.push_back(std::move(mesh));
         scene.draws.push_back(draw);
