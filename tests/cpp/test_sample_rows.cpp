@@ -85,6 +85,57 @@ TEST(SampleRows, SameBitsAndCountersAsThePerSamplePathOnOverlappingScenes) {
     }
 }
 
+TEST(SampleRows, AlphaTestedRowsGiveThePerSampleBits) {
+    // An alpha-tested draw tests its long rows a vector at a time without writing depth, and writes
+    // the depth and colour of what survives its alpha test afterwards: the per-sample path's bits
+    // and counters, textured (the texture's alpha, half the squares below the cutoff) and
+    // untextured (vertex alphas in [0.2, 1]), depth written or only read, drawn over opaque
+    // triangles and under more; at one sample, SSAA and MSAA (pixel rows at 4 and 8 samples, the
+    // per-sample path at 6).
+    const int W = 96, H = 80;
+    const mr::Mesh a = overlapping(150, 2.5, 44), b = overlapping(100, 1.5, 45);
+    std::vector<float> texels;
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) {
+            const float alpha = (x / 2 + y / 2) % 2 ? 0.9f : 0.3f;
+            texels.insert(texels.end(), {alpha * (x + 1) / 16.0f, alpha * (y + 1) / 16.0f, alpha * 0.5f, alpha});
+        }
+    const mr::Texture texture = mr::Texture::from_float(texels.data(), 16, 16, 4, true, "alpha checker");
+    glm::dmat4 shifted(1.0);
+    shifted[3] = glm::dvec4(0.2, 0.1, 0.5, 1.0);
+    std::uint64_t discarded = 0;
+    for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
+        const mr::Camera cam = overlap_camera(convention, W, H);
+        for (bool depth_write : {true, false}) {
+            mr::DrawState masked;
+            masked.alpha_cutoff = 0.6f;
+            masked.depth_write = depth_write;
+            std::vector<mr::Draw> draws = {make_draw(b, shifted, mr::DrawState()),
+                                           make_draw(a, glm::dmat4(1.0), masked), make_draw(b, glm::dmat4(1.0), masked),
+                                           make_draw(a, shifted, mr::DrawState(), glm::vec4(0.3f, 0.9f, 0.4f, 1.0f))};
+            draws[1].texture = texture;
+            for (const auto& [samples, pattern, aa] :
+                 {std::tuple{1, mr::PatternKind::automatic, mr::AntiAliasing::ssaa},
+                  std::tuple{4, mr::PatternKind::rotated, mr::AntiAliasing::ssaa},
+                  std::tuple{4, mr::PatternKind::rotated, mr::AntiAliasing::msaa},
+                  std::tuple{8, mr::PatternKind::stratified, mr::AntiAliasing::msaa},
+                  std::tuple{6, mr::PatternKind::stratified, mr::AntiAliasing::msaa}}) {
+                SCOPED_TRACE(mr::to_string(convention) + (depth_write ? ", depth written, " : ", depth read, ") +
+                             std::to_string(samples) + " samples " + mr::to_string(aa));
+                auto s = settings(W, H, samples, pattern);
+                s.anti_aliasing = aa;
+                s.threads = 1;
+                s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+                expect_same_with_and_without_rows(draws, cam, s);
+                // (the alpha test discarded samples: shaded samples outnumber passed ones)
+                const mr::RenderResult r = mr::render(draws, cam, s);
+                if (aa == mr::AntiAliasing::ssaa) discarded += r.stats.shader_invocations - r.stats.samples_passed;
+            }
+        }
+    }
+    EXPECT_GT(discarded, 1000u);
+}
+
 TEST(SampleRows, UntexturedRowsColouredInBatchesGiveThePerSampleBits) {
     // Untextured screen and perspective shading colours a row's passed pixels in batches
     // (interpolate_colours), skipping the weighted sums of one-colour triangles: the per-sample

@@ -93,7 +93,9 @@ inline bool queues_lookups(const DrawInputs& draw) {
 // is inside the triangle, else at its first sample that passed; else each sample), alpha-tested,
 // and only then its depth and colour written. Every other path writes depth as it tests it; a
 // branch for alpha testing inside their loops cost the other draws 3–5 % of the kernel's
-// instructions (many_small MSAA 4x), so alpha-tested triangles take this one, sample by sample.
+// instructions (many_small MSAA 4x), so alpha-tested triangles take this one. Long depth-tested
+// rows are tested a vector at a time without writing depth (test_sample_row, test_pixel_row_avx2:
+// the per-sample path's bits), the others sample by sample.
 // With `sampler` (a textured draw with batched lookups), shades go kLookupBatch at a time through
 // interpolate_batch and the BatchSampler, as the lookup queue sends them: the bits of the same draw
 // without a cutoff; they wait within the triangle only, whose samples are all distinct.
@@ -111,29 +113,48 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
     TriangleUvs uvs;
     if constexpr (kTexturing != Texturing::none) uvs = TriangleUvs(t, tri, draw.uvs, clip_weights);
     std::int64_t off[3][kMaxSamples];  // edge offsets of each sample from its pixel's corner
+    double offsets[3][kMaxSamples];    // (the same, as test_pixel_row_avx2 takes them)
     for (int s = 0; s < S; ++s)
-        for (int i = 0; i < 3; ++i)
+        for (int i = 0; i < 3; ++i) {
             off[i][s] = std::int64_t{t.edge_a[i]} * pattern.x[s] + std::int64_t{t.edge_b[i]} * pattern.y[s];
+            offsets[i][s] = static_cast<double>(off[i][s]);
+        }
+    // Edge values at the top-left corner of pixel (px, py), exact in int64.
+    const auto corner = [&](int px, int py, std::int64_t (&p)[3]) {
+        const std::int64_t X = std::int64_t{px} * kStep, Y = std::int64_t{py} * kStep;
+        for (int i = 0; i < 3; ++i) p[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+    };
+    const auto weights_at = [&](const std::int64_t (&p)[3], int s) {
+        return screen_weights(t, p[0] + off[0][s], p[1] + off[1][s], p[2] + off[2][s]);
+    };
 
-    // Samples `samples` of pixel (px, py) with colour c: discarded, or counted as passed, their
-    // colour written and (depth_write) their depths z[s].
-    const auto test_and_write = [&](int px, int py, std::uint64_t samples, glm::vec4 c, const float* z) {
+    // Samples `samples` of pixel (px, py), shaded at screen weights l with colour c: discarded, or
+    // counted as passed, their colour written and (depth_write) the depths their tests computed:
+    // from l where it is the sample's own (one sample shaded), else from the sample's position.
+    const auto test_and_write = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l, glm::vec4 c) {
         if (!alpha_test(c, *draw.alpha_cutoff)) return;
+        if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
+        if constexpr (kMode != SampleMode::msaa) {
+            const int s = __builtin_ctzll(samples);  // (the only one)
+            ++counters.samples_passed;
+            if (kDepth != DepthFunc::none && draw.depth_write) *target.depth.at(px, py, s) = sample_depth(t, l);
+            return blend_into<kBlend>(target.color.at(px, py, s), c);
+        }
         counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples));  // (as GL counts them)
         float* const color_px = target.color.at(px, py, 0);
         float* const depth_px = kDepth != DepthFunc::none && draw.depth_write ? target.depth.at(px, py, 0) : nullptr;
+        std::int64_t p[3];
+        if (depth_px) corner(px, py, p);
         for (std::uint64_t m = samples; m; m &= m - 1) {
             const int s = __builtin_ctzll(m);
-            if (depth_px) depth_px[s] = z[s];
+            if (depth_px) depth_px[s] = sample_depth(t, weights_at(p, s));
             blend_into<kBlend>(color_px + 4 * s, c);
         }
-        if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
     };
-    // The shades waiting for a batch (with `sampler`): screen weights, pixel, samples, depths.
+    // The shades waiting for a batch (with `sampler`): pixel and samples (screen weights in `weights`).
     struct Waiting {
         int px, py;
         std::uint64_t samples;
-        float z[kMaxSamples];
     };
     BatchWeights weights;
     Waiting waiting[kLookupBatch];
@@ -157,57 +178,94 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
         }
         sampler->sample(lookups, texel);
         for (int i = 0; i < n; ++i)
-            test_and_write(waiting[i].px, waiting[i].py, waiting[i].samples, colour[i] * texel[i], waiting[i].z);
+            test_and_write(waiting[i].px, waiting[i].py, waiting[i].samples,
+                           glm::dvec3(weights.l0[i], weights.l1[i], weights.l2[i]), colour[i] * texel[i]);
         weights.count = 0;
     };
-    // Shades samples `samples` of pixel (px, py) at screen weights l (their depths z).
-    const auto shade_samples = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l, const float* z) {
+    // Shades samples `samples` of pixel (px, py) at screen weights l.
+    const auto shade_samples = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l) {
         ++counters.shader_invocations;
         if (!sampler) {
             const glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, l, clip_weights, px, py);
-            test_and_write(px, py, samples, c, z);
+            test_and_write(px, py, samples, l, c);
             return;
         }
         const int i = weights.count++;
         weights.l0[i] = l.x, weights.l1[i] = l.y, weights.l2[i] = l.z;
-        waiting[i].px = px, waiting[i].py = py, waiting[i].samples = samples;
-        if constexpr (kDepth != DepthFunc::none)
-            for (std::uint64_t m = samples; m; m &= m - 1) waiting[i].z[__builtin_ctzll(m)] = z[__builtin_ctzll(m)];
+        waiting[i] = {px, py, samples};
         if (weights.count == kLookupBatch) shade_waiting();
     };
+    // MSAA shades samples `passed` of pixel (px, py), whose corner has edge values p, once.
+    const auto shade_pixel = [&](int px, int py, std::uint64_t passed, const std::int64_t (&p)[3]) {
+        const std::int64_t c0 = p[0] + (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * (kStep / 2);
+        const std::int64_t c1 = p[1] + (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * (kStep / 2);
+        const std::int64_t c2 = p[2] + (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * (kStep / 2);
+        shade_samples(px, py, passed,
+                      (c0 | c1 | c2) >= 0 ? screen_weights(t, c0, c1, c2) : weights_at(p, __builtin_ctzll(passed)));
+    };
+
+    // A long depth-tested row of pixels [x0, x1), tested a vector at a time: false (nothing done)
+    // where the vectors' sums could round.
+    const int n = x1 - x0;
+    const auto vector_row = [&](int py) {
+        if constexpr (kDepth == DepthFunc::none) {
+            return false;
+        } else {
+            if (!target.sample_rows || n < kSampleRowMinPixels) return false;
+            std::int64_t row[3];
+            corner(x0, py, row);
+            if (kMode != SampleMode::single && !sample_rows_exact(t, row, n)) return false;
+            if constexpr (kMode == SampleMode::msaa) {
+                if (S % 4 != 0 || BatchSampler::widest_vector() != 8) return false;
+                std::uint64_t samples[kTileSize];
+                const double* const by_sample[3] = {offsets[0], offsets[1], offsets[2]};
+                counters.samples_covered += test_pixel_row_avx2(t, row, n, by_sample, S, kDepth, false,
+                                                                target.depth.at(x0, py, 0), samples);
+                for (int j = 0; j < n; ++j) {
+                    if (!samples[j]) continue;
+                    std::int64_t p[3];
+                    for (int i = 0; i < 3; ++i) p[i] = row[i] + j * std::int64_t{t.edge_a[i]} * kStep;
+                    shade_pixel(x0 + j, py, samples[j], p);
+                }
+            } else {
+                for (int s = 0; s < S; ++s) {
+                    const std::int64_t e[3] = {row[0] + off[0][s], row[1] + off[1][s], row[2] + off[2][s]};
+                    SampleRow r;
+                    if (!test_sample_row(t, e, n, ~std::uint32_t{0}, kDepth, false, target.depth.at(x0, py, s), S, r))
+                        return false;  // (one sample: nothing done yet)
+                    counters.samples_covered += static_cast<std::uint64_t>(count_bits(r.covered));
+                    for (std::uint32_t m = r.passed; m; m &= m - 1) {
+                        const int j = __builtin_ctz(m);
+                        shade_samples(x0 + j, py, std::uint64_t{1} << s, glm::dvec3(r.l0[j], r.l1[j], r.l2[j]));
+                    }
+                }
+            }
+            return true;
+        }
+    };
+
     for (int py = y0; py < y1; ++py) {
+        if (vector_row(py)) continue;
         for (int px = x0; px < x1; ++px) {
-            const std::int64_t X = std::int64_t{px} * kStep, Y = std::int64_t{py} * kStep;
             std::int64_t p[3];
-            for (int i = 0; i < 3; ++i) p[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
-            float z[kMaxSamples];
+            corner(px, py, p);
             const float* const stored = kDepth != DepthFunc::none ? target.depth.at(px, py, 0) : nullptr;
             std::uint64_t passed = 0;
             for (int s = 0; s < S; ++s) {
                 const std::int64_t e0 = p[0] + off[0][s], e1 = p[1] + off[1][s], e2 = p[2] + off[2][s];
                 if ((e0 | e1 | e2) < 0) continue;
                 ++counters.samples_covered;
-                if constexpr (kDepth != DepthFunc::none) {
-                    z[s] = sample_depth(t, screen_weights(t, e0, e1, e2));
-                    if (!depth_passes<kDepth>(z[s], stored[s])) continue;
-                }
+                if constexpr (kDepth != DepthFunc::none)
+                    if (!depth_passes<kDepth>(sample_depth(t, screen_weights(t, e0, e1, e2)), stored[s])) continue;
                 passed |= std::uint64_t{1} << s;
             }
             if (!passed) continue;
-            const auto weights_at = [&](int s) {
-                return screen_weights(t, p[0] + off[0][s], p[1] + off[1][s], p[2] + off[2][s]);
-            };
             if constexpr (kMode == SampleMode::msaa) {
-                const std::int64_t c0 = p[0] + (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * (kStep / 2);
-                const std::int64_t c1 = p[1] + (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * (kStep / 2);
-                const std::int64_t c2 = p[2] + (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * (kStep / 2);
-                const glm::dvec3 l =
-                    (c0 | c1 | c2) >= 0 ? screen_weights(t, c0, c1, c2) : weights_at(__builtin_ctzll(passed));
-                shade_samples(px, py, passed, l, z);
+                shade_pixel(px, py, passed, p);
             } else {
                 for (std::uint64_t m = passed; m; m &= m - 1) {
                     const int s = __builtin_ctzll(m);
-                    shade_samples(px, py, std::uint64_t{1} << s, weights_at(s), z);
+                    shade_samples(px, py, std::uint64_t{1} << s, weights_at(p, s));
                 }
             }
         }
