@@ -150,6 +150,47 @@ TEST(BlockSkipping, BoundingBoxesFromSixteenPixelsAreClassified) {
     EXPECT_EQ(r.stats.triangles_rasterized, 2u + 64u);
 }
 
+TEST(BlockSkipping, AlphaTestedDrawsSkipBlocksWithThePlainPathsBitsAndCounters) {
+    // Alpha-tested draws (vertex alphas in [0.2, 1] against a cutoff of 0.6; one also textured)
+    // drawn after an opaque one: their blocks are classified as other draws' are, so those hidden
+    // behind what is drawn are rejected, and colour, depth and counters are the plain path's, with
+    // their depth written or only read.
+    const int W = 96, H = 80;
+    const mr::Mesh a = random_overlap(160, 2.5, 13), b = random_overlap(120, 1.2, 14);
+    mr::Mesh textured = random_overlap(120, 1.2, 15);
+    for (const glm::vec3& p : textured.positions) textured.uvs.push_back(glm::vec2(1.7f * p.x, 2.3f * p.y));
+    const struct {
+        mr::AntiAliasing aa;
+        int samples;
+    } modes[] = {{mr::AntiAliasing::ssaa, 1}, {mr::AntiAliasing::ssaa, 4}, {mr::AntiAliasing::msaa, 4},
+                 {mr::AntiAliasing::msaa, 6}};
+    for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
+        const mr::Camera cam = overlap_camera(convention, W, H);
+        for (bool depth_write : {true, false}) {
+            mr::DrawState masked;
+            masked.alpha_cutoff = 0.6f;
+            masked.depth_write = depth_write;
+            std::vector<mr::Draw> draws = {make_draw(a, glm::dmat4(1.0), {}), make_draw(b, glm::dmat4(1.0), masked),
+                                           make_draw(textured, glm::dmat4(1.0), masked)};
+            draws[2].texture = checker_texture();
+            for (const auto& mode : modes)
+                for (int threads : {1, 2}) {
+                    SCOPED_TRACE(mr::to_string(convention) + (depth_write ? ", depth written, " : ", depth read, ") +
+                                 mr::to_string(mode.aa) + " " + std::to_string(mode.samples) + ", " +
+                                 std::to_string(threads) + " threads");
+                    auto s = settings(W, H, mode.samples);
+                    s.anti_aliasing = mode.aa;
+                    s.threads = threads;
+                    const auto [plain, fast] = render_off_on(draws, cam, s, &mr::RenderSettings::block_skipping);
+                    expect_same_render(fast, plain);
+                    EXPECT_EQ(plain.stats.depth_blocks_rejected, 0u);
+                    const mr::RenderResult opaque = mr::render({draws[0]}, cam, s);
+                    EXPECT_GT(fast.stats.depth_blocks_rejected, opaque.stats.depth_blocks_rejected + 10);
+                }
+        }
+    }
+}
+
 TEST(BlockSkipping, AnOccluderDrawnFirstHidesEveryBlockBehindIt) {
     // A full-screen quad at z = 1, then 50 triangles behind it at z = −1 that cover the screen:
     // each of them fails everywhere, so every block they fill is skipped and no sample passes.

@@ -93,16 +93,18 @@ inline bool queues_lookups(const DrawInputs& draw) {
 // is inside the triangle, else at its first sample that passed; else each sample), alpha-tested,
 // and only then its depth and colour written. Every other path writes depth as it tests it; a
 // branch for alpha testing inside their loops cost the other draws 3–5 % of the kernel's
-// instructions (many_small MSAA 4x), so alpha-tested triangles take this one. Long depth-tested
-// rows are tested a vector at a time without writing depth (test_sample_row, test_pixel_row_avx2:
-// the per-sample path's bits), the others sample by sample.
+// instructions (many_small MSAA 4x), so alpha-tested triangles take this one. Blocks are skipped
+// as `cls` (the triangle's TileBlocks classes) says; long depth-tested rows are tested a vector at
+// a time without writing depth (test_sample_row, test_pixel_row_avx2: the per-sample path's
+// bits), the others sample by sample.
 // With `sampler` (a textured draw with batched lookups), shades go kLookupBatch at a time through
 // interpolate_batch and the BatchSampler, as the lookup queue sends them: the bits of the same draw
 // without a cutoff; they wait within the triangle only, whose samples are all distinct.
 template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode, Texturing kTexturing>
 [[gnu::noinline]] void alpha_tested_triangle(const TileTarget& target, const DrawInputs& draw, const SetupTriangle& t,
                                              const ClipWeights* clip_weights, int x0, int y0, int x1, int y1,
-                                             BatchSampler* sampler, TileBlocks& blocks, TileCounters& counters) {
+                                             const BlockClasses& cls, BatchSampler* sampler, TileBlocks& blocks,
+                                             TileCounters& counters) {
     const SamplePattern& pattern = *target.pattern;
     const int S = kMode == SampleMode::single ? 1 : pattern.count();
     constexpr std::int64_t kStep = kSubpixelOne;
@@ -141,15 +143,15 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
             return blend_into<kBlend>(target.color.at(px, py, s), c);
         }
         counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples));  // (as GL counts them)
-        float* const color_px = target.color.at(px, py, 0);
-        float* const depth_px = kDepth != DepthFunc::none && draw.depth_write ? target.depth.at(px, py, 0) : nullptr;
-        std::int64_t p[3];
-        if (depth_px) corner(px, py, p);
-        for (std::uint64_t m = samples; m; m &= m - 1) {
-            const int s = __builtin_ctzll(m);
-            if (depth_px) depth_px[s] = sample_depth(t, weights_at(p, s));
-            blend_into<kBlend>(color_px + 4 * s, c);
+        if (kDepth != DepthFunc::none && draw.depth_write) {
+            float* const depth_px = target.depth.at(px, py, 0);
+            std::int64_t p[3];
+            corner(px, py, p);
+            for (std::uint64_t m = samples; m; m &= m - 1)
+                depth_px[__builtin_ctzll(m)] = sample_depth(t, weights_at(p, __builtin_ctzll(m)));
         }
+        float* const color_px = target.color.at(px, py, 0);
+        for (std::uint64_t m = samples; m; m &= m - 1) blend_into<kBlend>(color_px + 4 * __builtin_ctzll(m), c);
     };
     // The shades waiting for a batch (with `sampler`): pixel and samples (screen weights in `weights`).
     struct Waiting {
@@ -204,39 +206,42 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
                       (c0 | c1 | c2) >= 0 ? screen_weights(t, c0, c1, c2) : weights_at(p, __builtin_ctzll(passed)));
     };
 
-    // A long depth-tested row of pixels [x0, x1), tested a vector at a time: false (nothing done)
-    // where the vectors' sums could round.
-    const int n = x1 - x0;
-    const auto vector_row = [&](int py) {
+    // A long depth-tested row of pixels [rx0, rx0 + n), tested a vector at a time: false (nothing
+    // done) where the vectors' sums could round, or under MSAA where a block is classified.
+    const std::uint32_t classified = cls.skipped | cls.hidden;
+    const auto vector_row = [&](int rx0, int py, int n) {
         if constexpr (kDepth == DepthFunc::none) {
             return false;
         } else {
             if (!target.sample_rows || n < kSampleRowMinPixels) return false;
             std::int64_t row[3];
-            corner(x0, py, row);
+            corner(rx0, py, row);
             if (kMode != SampleMode::single && !sample_rows_exact(t, row, n)) return false;
             if constexpr (kMode == SampleMode::msaa) {
-                if (S % 4 != 0 || BatchSampler::widest_vector() != 8) return false;
+                if (S % 4 != 0 || BatchSampler::widest_vector() != 8 || blocks.row_pixels(classified, py, rx0, n))
+                    return false;
                 std::uint64_t samples[kTileSize];
                 const double* const by_sample[3] = {offsets[0], offsets[1], offsets[2]};
                 counters.samples_covered += test_pixel_row_avx2(t, row, n, by_sample, S, kDepth, false,
-                                                                target.depth.at(x0, py, 0), samples);
+                                                                target.depth.at(rx0, py, 0), samples);
                 for (int j = 0; j < n; ++j) {
                     if (!samples[j]) continue;
                     std::int64_t p[3];
                     for (int i = 0; i < 3; ++i) p[i] = row[i] + j * std::int64_t{t.edge_a[i]} * kStep;
-                    shade_pixel(x0 + j, py, samples[j], p);
+                    shade_pixel(rx0 + j, py, samples[j], p);
                 }
             } else {
+                const std::uint32_t skipped = blocks.row_pixels(cls.skipped, py, rx0, n);
+                const std::uint32_t untested = skipped | blocks.row_pixels(cls.hidden, py, rx0, n);
                 for (int s = 0; s < S; ++s) {
                     const std::int64_t e[3] = {row[0] + off[0][s], row[1] + off[1][s], row[2] + off[2][s]};
                     SampleRow r;
-                    if (!test_sample_row(t, e, n, ~std::uint32_t{0}, kDepth, false, target.depth.at(x0, py, s), S, r))
+                    if (!test_sample_row(t, e, n, ~untested, kDepth, false, target.depth.at(rx0, py, s), S, r))
                         return false;  // (one sample: nothing done yet)
-                    counters.samples_covered += static_cast<std::uint64_t>(count_bits(r.covered));
+                    counters.samples_covered += static_cast<std::uint64_t>(count_bits(r.covered & ~skipped));
                     for (std::uint32_t m = r.passed; m; m &= m - 1) {
                         const int j = __builtin_ctz(m);
-                        shade_samples(x0 + j, py, std::uint64_t{1} << s, glm::dvec3(r.l0[j], r.l1[j], r.l2[j]));
+                        shade_samples(rx0 + j, py, std::uint64_t{1} << s, glm::dvec3(r.l0[j], r.l1[j], r.l2[j]));
                     }
                 }
             }
@@ -245,19 +250,32 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
     };
 
     for (int py = y0; py < y1; ++py) {
-        if (vector_row(py)) continue;
-        for (int px = x0; px < x1; ++px) {
+        int rx0 = x0, rx1 = x1;  // the row without skipped blocks at its ends
+        blocks.trim(cls.skipped, py, rx0, rx1);
+        if (rx0 >= rx1 || vector_row(rx0, py, rx1 - rx0)) continue;
+        for (int px = rx0; px < rx1; ++px) {
             std::int64_t p[3];
             corner(px, py, p);
-            const float* const stored = kDepth != DepthFunc::none ? target.depth.at(px, py, 0) : nullptr;
-            std::uint64_t passed = 0;
+            std::uint64_t covered = 0;
             for (int s = 0; s < S; ++s) {
-                const std::int64_t e0 = p[0] + off[0][s], e1 = p[1] + off[1][s], e2 = p[2] + off[2][s];
-                if ((e0 | e1 | e2) < 0) continue;
-                ++counters.samples_covered;
-                if constexpr (kDepth != DepthFunc::none)
-                    if (!depth_passes<kDepth>(sample_depth(t, screen_weights(t, e0, e1, e2)), stored[s])) continue;
-                passed |= std::uint64_t{1} << s;
+                const std::int64_t signs = (p[0] + off[0][s]) | (p[1] + off[1][s]) | (p[2] + off[2][s]);
+                covered |= static_cast<std::uint64_t>(signs >= 0) << s;
+            }
+            if (!covered) continue;
+            if (classified && (classified >> blocks.bit(px, py) & 1)) {  // counted, not tested
+                if (cls.hidden >> blocks.bit(px, py) & 1)
+                    counters.samples_covered += static_cast<std::uint64_t>(count_bits(covered));
+                continue;
+            }
+            counters.samples_covered += static_cast<std::uint64_t>(count_bits(covered));
+            std::uint64_t passed = covered;
+            if constexpr (kDepth != DepthFunc::none) {
+                const float* const stored = target.depth.at(px, py, 0);
+                for (std::uint64_t m = covered; m; m &= m - 1) {
+                    const int s = __builtin_ctzll(m);
+                    if (!depth_passes<kDepth>(sample_depth(t, weights_at(p, s)), stored[s]))
+                        passed &= ~(std::uint64_t{1} << s);
+                }
             }
             if (!passed) continue;
             if constexpr (kMode == SampleMode::msaa) {
@@ -304,14 +322,6 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
         const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
         if (x0 >= x1 || y0 >= y1) continue;
-        if constexpr (kShading != Shading::visibility) {  // (deferred shading never takes alpha-tested draws)
-            if (draw.alpha_cutoff) {
-                alpha_tested_triangle<kDepth, kBlend, kShading, kMode, kTexturing>(
-                    target, draw, t, batch.clip_weights, x0, y0, x1, y1, alpha_sampler ? &*alpha_sampler : nullptr,
-                    blocks, counters);
-                continue;
-            }
-        }
         // Blocks with nothing to do, and blocks whose depth tests would all fail (tile_blocks.hpp).
         BlockClasses cls;
         if (target.block_skipping) {
@@ -319,6 +329,14 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             counters.samples_covered += cls.skipped_samples;
             counters.depth_blocks_rejected += static_cast<std::uint64_t>(cls.depth_rejected);
             if (cls.skipped && cls.skipped == blocks.blocks_in(x0, y0, x1, y1)) continue;  // every row would trim to nothing
+        }
+        if constexpr (kShading != Shading::visibility) {  // (deferred shading never takes alpha-tested draws)
+            if (draw.alpha_cutoff) {
+                alpha_tested_triangle<kDepth, kBlend, kShading, kMode, kTexturing>(
+                    target, draw, t, batch.clip_weights, x0, y0, x1, y1, cls,
+                    alpha_sampler ? &*alpha_sampler : nullptr, blocks, counters);
+                continue;
+            }
         }
         // Most small triangles classify no block: they skip the per-pixel block test.
         const std::uint32_t classified = cls.skipped | cls.hidden;
