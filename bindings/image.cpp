@@ -45,13 +45,15 @@ py::array_t<float> read_image_py(const std::string& path, bool srgb) {
     return image_to_array(std::move(image));
 }
 
-void write_image_py(const std::string& path, const CArray<float>& array) {
+void write_image_py(const std::string& path, const CArray<float>& array, int bits) {
     const Image image = to_image(array, "image");
+    ImageWriteOptions options;
+    options.png_bits = bits;
     std::string failure;
     {
         py::gil_scoped_release release;
         try {
-            write_image(path, image);  // std::invalid_argument (bad extension / image) → ValueError
+            write_image(path, image, options);  // std::invalid_argument (extension, image, bits) → ValueError
         } catch (const std::runtime_error& e) {
             failure = e.what();
             if (failure.empty()) failure = "write_image: cannot write '" + path + "'";
@@ -159,10 +161,11 @@ PYBIND11_MODULE(_image, m) {
           "Reads any file OpenImageIO reads into (H, W, 4) float32, linear premultiplied RGBA. 8-bit and\n"
           "16-bit files are decoded from sRGB (srgb=False: code / max code); float files are read as they are.\n"
           "Raises OSError (with .filename) when the file is missing, unreadable or corrupt.");
-    m.def("write_image", &write_image_py, py::arg("path"), py::arg("image"),
+    m.def("write_image", &write_image_py, py::arg("path"), py::arg("image"), py::arg("bits") = 8,
           "Writes (H, W, C) float32 (C = 1, 3 or 4; 4 = linear premultiplied RGBA) or (H, W): .png is sRGB\n"
-          "8-bit with straight alpha (1 channel: plain grey), .exr is linear float as given. ValueError for\n"
-          "another extension or a malformed image, OSError (with .filename) when the file cannot be written.");
+          "with straight alpha, 8 or 16 bits (1 channel: plain grey), .exr is linear float as given. ValueError\n"
+          "for another extension, a malformed image or bits, OSError (with .filename) when the file cannot be\n"
+          "written.");
 
     // This module links its own copy of the core, memory limit included: the Python layer hands
     // it the limit set through _core before each call.

@@ -77,7 +77,8 @@ constexpr const char* kUsage =
     "             mipraster study --help lists its options\n"
     "\n"
     "render options:\n"
-    "  -o, --output PATH     output image: .png (sRGB 8-bit) or .exr (linear float)  [required]\n"
+    "  -o, --output PATH     output image: .png (sRGB) or .exr (linear float)  [required]\n"
+    "  --bits N              bits per channel of a .png output, 8 or 16        [8]\n"
     "  --size WxH            image size in pixels                              [1280x720]\n"
     "  --spp N               samples per pixel, 1..64                          [4]\n"
     "  --aa ssaa|msaa        shade every sample, or once per pixel per triangle [msaa]\n"
@@ -124,9 +125,10 @@ constexpr const char* kUsage =
     "  --json FILE           also write the rows as JSON (- = stdout)\n"
     "  --details             print the per-setting measurements under each row\n"
     "\n"
-    "resize IN -o OUT --size WxH [options]: read any image, write .png (sRGB 8-bit) or .exr\n"
+    "resize IN -o OUT --size WxH [options]: read any image, write .png (sRGB) or .exr\n"
     "  --filter F            box, tent, mitchell, catmull-rom, lanczos3          [mitchell]\n"
     "  --threads N           worker threads, 0 = all cores                     [0]\n"
+    "  --bits N              bits per channel of a .png output, 8 or 16        [8]\n"
     "\n"
     "synthesize SAMPLE -o OUT --size WxH [options]: every output pixel is copied from the sample\n"
     "  --window N            odd neighbourhood side, at most the sample's sides [11]\n"
@@ -135,6 +137,7 @@ constexpr const char* kUsage =
     "  --periodic            the sample tiles: its neighbourhoods wrap around its edges\n"
     "  --tileable            make the output tile (its neighbourhoods wrap around)\n"
     "  --threads N           worker threads, 0 = all cores                     [0]\n"
+    "  --bits N              bits per channel of a .png output, 8 or 16        [8]\n"
     "\n"
     "  mipraster --help | --version\n";
 
@@ -153,6 +156,20 @@ int parse_int(const std::string& option, const std::string& text) {
     if (used != text.size() || text.empty() || value < -(1L << 30) || value > (1L << 30))
         throw UsageError(option + ": expected an integer, got '" + text + "'");
     return static_cast<int>(value);
+}
+
+// --bits N for the image written to `output`: 8 or 16, and 16 only for a PNG (checked before any
+// work, which write_image would refuse only at the end).
+ImageWriteOptions parse_bits(const std::string& text, const std::string& output) {
+    ImageWriteOptions options;
+    options.png_bits = parse_int("--bits", text);
+    if (options.png_bits != 8 && options.png_bits != 16)
+        throw UsageError("--bits: expected 8 or 16 (bits per PNG channel), got '" + text + "'");
+    std::string ext = output.size() >= 4 ? output.substr(output.size() - 4) : "";
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (options.png_bits == 16 && ext != ".png")
+        throw UsageError("--bits 16: only a .png output has 16-bit channels, not '" + output + "'");
+    return options;
 }
 
 // A seed: any integer from 0 to 2^64 - 1, as the Python API takes.
@@ -220,6 +237,7 @@ struct RenderOptions {
     std::string scene;  ///< scene file; empty: the built-in demo
     int camera = -1;    ///< --camera N; −1: not given
     std::string output;
+    std::string bits = "8";  ///< --bits, checked against the output once both are known
     RenderSettings settings;
     bool print_stats = false;
     std::string stats_json;  ///< path, "-" for stdout, empty for none
@@ -344,6 +362,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
                 throw UsageError("--probe-pixels: expected 0 (no probe) or a number of pixels, got " + args[i]);
         } else if (a == "--quiet") {
             o.quiet = true;
+        } else if (a == "--bits") {
+            o.bits = value();
         } else if (!a.empty() && a[0] != '-' && o.scene.empty()) {
             o.scene = a;
         } else if (!a.empty() && a[0] != '-') {
@@ -355,6 +375,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     if (o.camera >= 0 && o.scene.empty())
         throw UsageError("--camera: needs a scene file (the built-in demo has one camera)");
     if (o.output.empty()) throw UsageError("render: missing -o PATH (where to write the image)");
+    parse_bits(o.bits, o.output);
     if (!o.error_map.empty() && o.settings.samples < 2)
         throw UsageError("--error-map: the estimate compares two halves of each pixel's samples; give --spp 2 or more");
     return o;
@@ -428,7 +449,7 @@ int run_render(const std::vector<std::string>& args) {
             result.error_estimate = summarize_error_map(result.error_map);
         }
     }
-    write_image(o.output, result.color);
+    write_image(o.output, result.color, parse_bits(o.bits, o.output));
     if (!o.quiet)
         std::printf("wrote %s (%dx%d, %d spp %s, %.1f ms on %d threads)\n", o.output.c_str(), settings.width,
                     settings.height, settings.samples, to_string(settings.anti_aliasing).c_str(), result.stats.total_ms,
@@ -473,7 +494,7 @@ std::pair<int, int> parse_size(const std::string& text, int limit) {
 // The options shared by resize and synthesize: one input, -o OUT, --size, --threads, --quiet;
 // `extra` handles the command's own options (returns false for an unknown one).
 struct ImageCommand {
-    std::string input, output;
+    std::string input, output, bits = "8";
     int width = 0, height = 0, threads = 0;
     bool quiet = false;
 };
@@ -497,6 +518,8 @@ ImageCommand parse_image_command(const char* command, const std::vector<std::str
             resolve_thread_count(o.threads);  // throws naming threads
         } else if (a == "--quiet") {
             o.quiet = true;
+        } else if (a == "--bits") {
+            o.bits = value();
         } else if (extra(a, value)) {
         } else if (!a.empty() && a[0] != '-' && o.input.empty()) {
             o.input = a;
@@ -508,6 +531,7 @@ ImageCommand parse_image_command(const char* command, const std::vector<std::str
     }
     if (o.input.empty()) throw UsageError(std::string(command) + ": missing the input image");
     if (o.output.empty()) throw UsageError(std::string(command) + ": missing -o PATH (where to write the image)");
+    parse_bits(o.bits, o.output);
     if (o.width == 0) throw UsageError(std::string(command) + ": missing --size WxH");
     return o;
 }
@@ -523,7 +547,7 @@ int run_resize(const std::vector<std::string>& args) {
     const auto start = std::chrono::steady_clock::now();
     const Image out = resample(image, o.width, o.height, filter, o.threads);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    write_image(o.output, out);
+    write_image(o.output, out, parse_bits(o.bits, o.output));
     if (!o.quiet)
         std::printf("wrote %s (%dx%d from %dx%d, %s, %.1f ms)\n", o.output.c_str(), o.width, o.height, image.width,
                     image.height, to_string(filter).c_str(), ms);
@@ -552,7 +576,7 @@ int run_synthesize(const std::vector<std::string>& args) {
         throw std::invalid_argument("--window " + std::to_string(settings.window) + ": larger than the sample " +
                                     o.input + " (" + std::to_string(sample.width) + "x" + std::to_string(sample.height) + ")");
     const SynthesisResult r = synthesize_texture(sample, settings);
-    write_image(o.output, r.image);
+    write_image(o.output, r.image, parse_bits(o.bits, o.output));
     if (!o.quiet)
         std::printf("wrote %s (%dx%d from %s, window %d, seed %llu, %.1f ms)\n", o.output.c_str(), o.width, o.height,
                     o.input.c_str(), settings.window, static_cast<unsigned long long>(settings.seed), r.milliseconds);

@@ -80,24 +80,28 @@ def read_image(path: PathLike, srgb: bool = True) -> np.ndarray:
     return _image_module().read_image(p, srgb)
 
 
-def write_image(path: PathLike, image: Any) -> None:
+def write_image(path: PathLike, image: Any, bits: int = 8) -> None:
     """Writes a linear float image; the format follows the extension.
 
     Args:
-        path: ``.png`` (sRGB 8-bit; RGBA un-premultiplied to straight alpha; 1 channel written as
-            plain grey) or ``.exr`` (32-bit float, values as given).
+        path: ``.png`` (sRGB; RGBA un-premultiplied to straight alpha; 1 channel written as plain
+            grey) or ``.exr`` (32-bit float, values as given).
         image: ``(H, W, 4)`` linear premultiplied RGBA, ``(H, W, 3)`` linear RGB, or ``(H, W)`` /
             ``(H, W, 1)`` data, any float dtype.
+        bits: a PNG's bits per channel, 8 (the default) or 16 (codes 256 times finer: smooth
+            gradients and dark tones without banding). An EXR takes only the default.
 
     Raises:
         TypeError: a non-float image.
-        ValueError: a wrong shape, a finite value beyond float32's range, or an unsupported
-            extension.
+        ValueError: a wrong shape, a finite value beyond float32's range, an unsupported
+            extension, or bits other than 8 or 16 (or than 8 for an EXR).
         OSError: the file cannot be written (the message names the path; ``.filename`` is set).
     """
     p = _path(path)
+    if isinstance(bits, bool) or not isinstance(bits, (int, np.integer)) or bits not in (8, 16):
+        raise ValueError(f"write_image: bits={bits!r}: a PNG has 8 or 16 bits per channel")
     a = _float_image(image, "image")
-    _image_module().write_image(p, np.ascontiguousarray(a, dtype=np.float32))
+    _image_module().write_image(p, np.ascontiguousarray(a, dtype=np.float32), int(bits))
 
 
 def to_srgb8(image: Any) -> np.ndarray:

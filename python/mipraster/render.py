@@ -105,15 +105,16 @@ class RenderResult:
         """``(H, W, 4)`` uint8: straight-alpha sRGB colour, alpha linear (as a PNG stores it)."""
         return _core.to_srgb8(self.color)
 
-    def save(self, path: Union[str, os.PathLike]) -> None:
-        """Writes :attr:`color`: ``.png`` as sRGB 8-bit (straight alpha), ``.exr`` as linear float.
+    def save(self, path: Union[str, os.PathLike], bits: int = 8) -> None:
+        """Writes :attr:`color`: ``.png`` as sRGB (straight alpha) with ``bits`` 8 or 16 per
+        channel, ``.exr`` as linear float.
 
-        Raises ValueError for another extension and OSError (with ``.filename``) when the file
-        cannot be written.
+        Raises ValueError for another extension or bit depth and OSError (with ``.filename``) when
+        the file cannot be written.
         """
         from .image import write_image
 
-        write_image(path, self.color)
+        write_image(path, self.color, bits=bits)
 
     def __repr__(self) -> str:
         return (f"RenderResult({self.width}x{self.height}, spp={self.spp} {self.pattern_kind}, "

@@ -1,4 +1,4 @@
-// Tests for mipraster/core/colour.hpp: sRGB transfer functions and 8-bit encoding.
+// Tests for mipraster/core/colour.hpp: sRGB transfer functions and 8- and 16-bit encoding.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -71,4 +71,30 @@ TEST(Colour, ToSrgb8UnpremultipliesColourAndKeepsAlphaLinear) {
     ASSERT_EQ(out.size(), 12u);
     const std::vector<std::uint8_t> expected = {188, 188, 188, 255, 188, 188, 188, 128, 0, 0, 0, 0};
     EXPECT_EQ(out, expected);
+}
+
+TEST(Colour, SixteenBitCodesAreTheExactEncodingRoundedWithinOneCode) {
+    // linear_to_srgb16 against IEC 61966-2-1 in double, over a sweep and every 16-bit code's
+    // decoded value (which must encode back to that code: the decode and encode are inverses
+    // within float rounding); to_srgb16 is to_srgb8 with these codes.
+    for (int i = 0; i <= 100000; ++i) {
+        const double x = i / 100000.0;
+        const double exact = x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
+        const int code = mr::linear_to_srgb16(static_cast<float>(x));
+        EXPECT_LE(std::abs(code - exact * 65535.0), 1.0) << "linear " << x;
+    }
+    int off = 0;
+    for (int code = 0; code < 65536; code += 1) {
+        const float linear = mr::srgb_to_linear(static_cast<float>(code) / 65535.0f);
+        off += std::abs(static_cast<int>(mr::linear_to_srgb16(linear)) - code) > 1;
+    }
+    EXPECT_EQ(off, 0);
+    EXPECT_EQ(mr::linear_to_srgb16(0.5f), 48192);
+    EXPECT_EQ(mr::linear_to_srgb16(std::numeric_limits<float>::quiet_NaN()), 0);
+    mr::Image img(2, 1, 4);
+    for (int c = 0; c < 3; ++c) img.at(0, 0, c) = 0.25f, img.at(1, 0, c) = 2.0f;  // straight 0.5; over 1
+    img.at(0, 0, 3) = 0.5f;
+    img.at(1, 0, 3) = 1.0f;
+    const std::vector<std::uint16_t> expected = {48192, 48192, 48192, 32768, 65535, 65535, 65535, 65535};
+    EXPECT_EQ(mr::to_srgb16(img), expected);
 }

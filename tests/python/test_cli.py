@@ -108,6 +108,7 @@ def test_exr_output_is_openexr(tmp_path):
         (["--lod-bias", "x"], ["--lod-bias"]),
         (["--seed", "-1"], ["--seed", "from 0 to 18446744073709551615", "'-1'"]),  # (was taken as 2^64 - 1)
         (["--seed", "18446744073709551616"], ["--seed", "'18446744073709551616'"]),
+        (["--bits", "12"], ["--bits", "8 or 16", "'12'"]),
     ],
 )
 def test_bad_options_exit_2_naming_the_input(tmp_path, args, words):
@@ -116,6 +117,21 @@ def test_bad_options_exit_2_naming_the_input(tmp_path, args, words):
     for w in words:
         assert w in r.stderr
     assert not (tmp_path / "x.png").exists()
+
+
+def test_bits_16_writes_the_8_bit_image_in_finer_steps(tmp_path):
+    # The demo at 16 bits per channel: the 8-bit file's image within half an 8-bit step (both
+    # read back through read_image's sRGB decoding), in a file with 16-bit channels.
+    for bits in ("8", "16"):
+        r = run("render", "-o", str(tmp_path / f"demo{bits}.png"), "--size", "48x32", "--spp", "1", "--bits", bits)
+        assert r.returncode == 0, r.stderr
+    with open(tmp_path / "demo16.png", "rb") as f:
+        assert f.read(25)[24] == 16  # IHDR bit depth
+    fine, coarse = mr.read_image(tmp_path / "demo16.png"), mr.read_image(tmp_path / "demo8.png")
+    assert np.abs(mr.linear_to_srgb(fine) - mr.linear_to_srgb(coarse)).max() <= 0.5 / 255 + 2 / 65535
+    r = run("render", "-o", str(tmp_path / "x.exr"), "--bits", "16")
+    assert r.returncode == 2 and "--bits 16" in r.stderr and "x.exr" in r.stderr
+    assert not (tmp_path / "x.exr").exists()
 
 
 def test_any_seed_below_2_to_the_64(tmp_path):

@@ -220,3 +220,122 @@ def test_path_the_file_system_would_read_differently(tmp_path, name, words):
         with pytest.raises(ValueError, match=words):
             call()
     assert list(tmp_path.iterdir()) == []
+
+
+# --- 16-bit PNG ---------------------------------------------------------------------------------
+
+def decode_png(path):
+    """An independent PNG decoder for the 16-bit files below (zlib and the five row filters of the
+    PNG specification): (H, W, C) uint16 codes. Non-interlaced grey, RGB and RGBA only."""
+    import struct
+    import zlib
+
+    data = open(path, "rb").read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    at, idat, header = 8, b"", None
+    while at < len(data):
+        length, kind = struct.unpack(">I4s", data[at:at + 8])
+        body = data[at + 8:at + 8 + length]
+        if kind == b"IHDR":
+            header = struct.unpack(">IIBBBBB", body)
+        elif kind == b"IDAT":
+            idat += body
+        at += 12 + length
+    w, h, depth, colour_type, _, _, interlace = header
+    assert depth == 16 and interlace == 0
+    channels = {0: 1, 2: 3, 6: 4}[colour_type]
+    bpp, stride = 2 * channels, 2 * channels * w
+    raw = zlib.decompress(idat)
+    rows, prev = [], bytearray(stride)
+    for y in range(h):
+        kind, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - bpp] if i >= bpp else 0
+            b, c = prev[i], prev[i - bpp] if i >= bpp else 0
+            if kind == 1:
+                line[i] = (line[i] + a) & 255
+            elif kind == 2:
+                line[i] = (line[i] + b) & 255
+            elif kind == 3:
+                line[i] = (line[i] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(bytes(line))
+        prev = line
+    return np.frombuffer(b"".join(rows), dtype=">u2").reshape(h, w, channels).astype(np.uint16)
+
+
+def srgb_encode(linear):
+    """IEC 61966-2-1's encoding, in float64 (the test's own formula)."""
+    x = np.clip(np.nan_to_num(np.asarray(linear, np.float64), nan=0.0), 0.0, 1.0)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
+
+
+def test_png_16_bits_holds_srgb_codes_of_65535_steps(tmp_path):
+    # Linear premultiplied RGBA over [0, 1] (and beyond, clamped): the file holds straight-alpha
+    # sRGB codes round(encode(c / a) · 65535), alpha round(a · 65535), within one code of the
+    # float64 formula (the library encodes in float).
+    rng = np.random.default_rng(16)
+    straight = rng.uniform(-0.1, 1.1, size=(9, 11, 3))
+    alpha = rng.uniform(0.05, 1.0, size=(9, 11, 1))
+    alpha[0, 0] = 1.0
+    image = np.concatenate([straight * alpha, alpha], axis=-1).astype(np.float32)
+    mr.write_image(tmp_path / "deep.png", image, bits=16)
+    codes = decode_png(tmp_path / "deep.png")
+    assert codes.shape == (9, 11, 4)
+    want_colour = np.round(srgb_encode(image[..., :3].astype(np.float64) / image[..., 3:]) * 65535)
+    assert np.abs(codes[..., :3] - want_colour).max() <= 1
+    assert np.abs(codes[..., 3] - np.round(image[..., 3].astype(np.float64) * 65535)).max() <= 1
+    # 256 times finer than 8 bits: the 8-bit file's codes are these, rounded to 8 bits.
+    mr.write_image(tmp_path / "shallow.png", image)
+    shallow = np.asarray(Image.open(tmp_path / "shallow.png")).astype(np.int64)
+    assert np.abs(shallow - codes.astype(np.int64) / 257).max() <= 0.51
+
+
+@pytest.mark.parametrize("channels", [1, 3])
+def test_png_16_bits_grey_and_rgb(tmp_path, channels):
+    # RGB is sRGB-encoded without alpha; one channel is plain grey data, round(clamp(v) · 65535).
+    rng = np.random.default_rng(channels)
+    image = rng.uniform(-0.1, 1.1, size=(5, 6, channels)).astype(np.float32)
+    image[0, 0, 0] = np.nan
+    mr.write_image(tmp_path / "x.png", image, bits=16)
+    codes = decode_png(tmp_path / "x.png")
+    assert codes.shape == (5, 6, channels)
+    if channels == 1:
+        want = np.round(np.clip(np.nan_to_num(image.astype(np.float64), nan=0.0), 0, 1) * 65535)
+    else:
+        want = np.round(srgb_encode(image) * 65535)
+    assert np.abs(codes - want).max() <= 1
+
+
+def test_png_16_bits_reads_back_within_a_65535th(tmp_path):
+    # read_image decodes 16-bit files from sRGB: a round trip within the 16-bit quantization
+    # (8 bits: within 1/255).
+    rng = np.random.default_rng(3)
+    image = rng.uniform(0.0, 1.0, size=(6, 7, 4)).astype(np.float32)
+    image[..., 3] = 1.0
+    mr.write_image(tmp_path / "x.png", image, bits=16)
+    back = mr.read_image(tmp_path / "x.png")
+    # (sRGB decoding's slope is at most 2.4 / 1.055 ≈ 2.27, at 1: half a code step gives < 1.2 / 65535)
+    assert np.abs(back - image).max() < 2.5 / 65535
+
+
+def test_save_writes_16_bit_png(tmp_path):
+    result = grey_render(0.5)
+    result.save(tmp_path / "grey.png", bits=16)
+    assert np.all(decode_png(tmp_path / "grey.png") == [round(srgb_encode(0.5).item() * 65535)] * 3 + [65535])
+
+
+@pytest.mark.parametrize("path, bits, words", [
+    ("x.png", 12, ["bits", "12", "8 or 16"]),
+    ("x.png", True, ["bits", "8 or 16"]),
+    ("x.exr", 16, ["bits", "PNG", ".exr"]),
+])
+def test_write_image_refuses_bad_bit_depths(tmp_path, path, bits, words):
+    with pytest.raises(ValueError) as e:
+        mr.write_image(tmp_path / path, np.zeros((2, 2, 4), np.float32), bits=bits)
+    for w in words:
+        assert w in str(e.value), str(e.value)
+    assert not (tmp_path / path).exists()

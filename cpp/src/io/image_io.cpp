@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -37,7 +38,7 @@ FileKind output_kind(const std::string& path) {
     if (ext == ".exr") return FileKind::exr;
     const std::string what = ext.empty() ? "no file extension" : "unsupported extension '" + ext + "'";
     throw std::invalid_argument("write_image: cannot write '" + path + "': " + what +
-                                " (supported: .png for sRGB 8-bit, .exr for linear float)");
+                                " (supported: .png for sRGB 8 or 16 bits, .exr for linear float)");
 }
 
 void check_image(const std::string& path, const Image& image) {
@@ -56,13 +57,14 @@ void check_image(const std::string& path, const Image& image) {
                                     std::to_string(expected));
 }
 
-// 1-channel PNG: plain grey, round(clamp(v, 0, 1) * 255); NaN → 0.
-std::vector<std::uint8_t> grey8(const Image& image) {
-    std::vector<std::uint8_t> out(image.pixels.size());
+// 1-channel PNG: plain grey, round(clamp(v, 0, 1) * max code); NaN → 0.
+template <typename Code>
+std::vector<Code> grey_codes(const Image& image) {
+    std::vector<Code> out(image.pixels.size());
     for (std::size_t i = 0; i < out.size(); ++i) {
         const float v = image.pixels[i];
         const float clamped = v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f;  // NaN fails v > 0
-        out[i] = static_cast<std::uint8_t>(std::lround(clamped * 255.0f));
+        out[i] = static_cast<Code>(std::lround(clamped * static_cast<float>(std::numeric_limits<Code>::max())));
     }
     return out;
 }
@@ -81,11 +83,47 @@ void write_pixels(const std::string& path, const OIIO::ImageSpec& spec, OIIO::Ty
     if (!out->close()) throw std::runtime_error("write_image: cannot finish '" + path + "': " + out->geterror());
 }
 
+// A PNG of `image` with Code (8- or 16-bit) channels.
+template <typename Code>
+void write_png(const std::string& path, const Image& image) {
+    const OIIO::TypeDesc format = sizeof(Code) == 1 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16;
+    if (image.channels == 1) {
+        const std::vector<Code> codes = grey_codes<Code>(image);
+        OIIO::ImageSpec spec(image.width, image.height, 1, format);
+        spec.channelnames = {"Y"};
+        write_pixels(path, spec, format, codes.data());
+        return;
+    }
+    std::vector<Code> codes;  // straight-alpha sRGB RGBA
+    if constexpr (sizeof(Code) == 1) codes = to_srgb8(image);
+    else codes = to_srgb16(image);
+    int channels = 4;
+    if (image.channels == 3) {  // drop the (opaque) alpha that to_srgb8 adds
+        const std::size_t n = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+        for (std::size_t p = 0; p < n; ++p)
+            for (int c = 0; c < 3; ++c) codes[p * 3 + c] = codes[p * 4 + c];
+        codes.resize(n * 3);
+        channels = 3;
+    }
+    OIIO::ImageSpec spec(image.width, image.height, channels, format);
+    spec.attribute("oiio:ColorSpace", "sRGB");
+    // The codes already hold straight alpha; without this OpenImageIO would un-premultiply again.
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+    write_pixels(path, spec, format, codes.data());
+}
+
 }  // namespace
 
-void write_image(const std::string& path, const Image& image) {
+void write_image(const std::string& path, const Image& image, const ImageWriteOptions& options) {
     const FileKind kind = output_kind(path);
     check_image(path, image);
+    if (kind == FileKind::png && options.png_bits != 8 && options.png_bits != 16)
+        throw std::invalid_argument("write_image: cannot write '" + path + "': bits " +
+                                    std::to_string(options.png_bits) + " (a PNG has 8 or 16 bits per channel)");
+    if (kind == FileKind::exr && options.png_bits != 8)
+        throw std::invalid_argument("write_image: cannot write '" + path + "' with bits " +
+                                    std::to_string(options.png_bits) +
+                                    ": bits are for PNG files; .exr is always 32-bit float");
 
     if (kind == FileKind::exr) {
         OIIO::ImageSpec spec(image.width, image.height, image.channels, OIIO::TypeDesc::FLOAT);
@@ -95,28 +133,8 @@ void write_image(const std::string& path, const Image& image) {
         return;
     }
 
-    // PNG
-    if (image.channels == 1) {
-        const std::vector<std::uint8_t> bytes = grey8(image);
-        OIIO::ImageSpec spec(image.width, image.height, 1, OIIO::TypeDesc::UINT8);
-        spec.channelnames = {"Y"};
-        write_pixels(path, spec, OIIO::TypeDesc::UINT8, bytes.data());
-        return;
-    }
-    std::vector<std::uint8_t> bytes = to_srgb8(image);  // straight-alpha sRGB8 RGBA
-    int channels = 4;
-    if (image.channels == 3) {  // drop the (opaque) alpha that to_srgb8 adds
-        const std::size_t n = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
-        for (std::size_t p = 0; p < n; ++p)
-            for (int c = 0; c < 3; ++c) bytes[p * 3 + c] = bytes[p * 4 + c];
-        bytes.resize(n * 3);
-        channels = 3;
-    }
-    OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:ColorSpace", "sRGB");
-    // The bytes already hold straight alpha; without this OpenImageIO would un-premultiply again.
-    spec.attribute("oiio:UnassociatedAlpha", 1);
-    write_pixels(path, spec, OIIO::TypeDesc::UINT8, bytes.data());
+    if (options.png_bits == 16) write_png<std::uint16_t>(path, image);
+    else write_png<std::uint8_t>(path, image);
 }
 
 namespace {

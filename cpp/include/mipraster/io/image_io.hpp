@@ -1,5 +1,5 @@
 #pragma once
-// Image files: PNG (sRGB 8-bit) and OpenEXR (linear float) output, and input from any format
+// Image files: PNG (sRGB, 8 or 16 bits) and OpenEXR (linear float) output, and input from any format
 // OpenImageIO reads. This is the only part of mipraster that depends on OpenImageIO; its header
 // names no OpenImageIO type, so including it pulls in nothing from that library.
 #include <cstddef>
@@ -9,18 +9,25 @@
 
 namespace mipraster {
 
+/// How write_image stores an image.
+struct ImageWriteOptions {
+    int png_bits = 8;  ///< bits per channel of a PNG: 8 or 16 (other formats take only the default)
+};
+
 /// Writes `image` to `path`; the format follows the extension, compared case-insensitively:
-///  - `.png`: 8-bit. A 4-channel image (linear, premultiplied RGBA) is un-premultiplied and
-///    sRGB-encoded with `to_srgb8()`, alpha stored linearly (straight alpha, as PNG defines it).
-///    A 3-channel image (linear RGB, opaque) is sRGB-encoded the same way and written as RGB.
-///    A 1-channel image (data such as depth or a mask) is written as plain grey:
-///    round(clamp(v, 0, 1) · 255), with no sRGB encoding and NaN written as 0.
+///  - `.png`: 8 or 16 bits per channel (ImageWriteOptions::png_bits). A 4-channel image (linear,
+///    premultiplied RGBA) is un-premultiplied and sRGB-encoded with `to_srgb8()` or
+///    `to_srgb16()`, alpha stored linearly (straight alpha, as PNG defines it). A 3-channel image
+///    (linear RGB, opaque) is sRGB-encoded the same way and written as RGB. A 1-channel image
+///    (data such as depth or a mask) is written as plain grey: round(clamp(v, 0, 1) · max code),
+///    with no sRGB encoding and NaN written as 0.
 ///  - `.exr`: 32-bit float, values written exactly as they are (linear; RGBA stays premultiplied,
 ///    as OpenEXR defines it); 1-channel images are stored as channel "Y".
-/// Throws std::invalid_argument for another extension or a malformed image (channels other
-/// than 1, 3 or 4, zero size, pixel count not width·height·channels), and std::runtime_error
-/// naming the path and OpenImageIO's message when the file cannot be opened or written.
-void write_image(const std::string& path, const Image& image);
+/// Throws std::invalid_argument for another extension, a malformed image (channels other than 1,
+/// 3 or 4, zero size, pixel count not width·height·channels) or png_bits other than 8 or 16 (or
+/// not 8 for an EXR), and std::runtime_error naming the path and OpenImageIO's message when the
+/// file cannot be opened or written.
+void write_image(const std::string& path, const Image& image, const ImageWriteOptions& options = {});
 
 /// Reads any file OpenImageIO can read into a linear, premultiplied RGBA float image (C = 4,
 /// row 0 at the top, pixels in stored order: an EXIF orientation tag is not applied).
