@@ -224,6 +224,50 @@ def test_gltf_embedded_texture_and_default_sampler(tmp_path):
         assert np.abs(got[q] - expected).max() < 0.05, (q, got[q])
 
 
+def write_webp(path, texels):
+    """`texels` (linear, opaque) as a lossless WebP file: the sRGB bytes a PNG of them holds."""
+    Image.fromarray(mr.to_srgb8(texels)).save(path, "WEBP", lossless=True)
+    return path
+
+
+@pytest.mark.parametrize("fallback", [False, True])
+def test_gltf_webp_texture_of_ext_texture_webp(tmp_path, fallback):
+    # EXT_texture_webp: the texture's WebP source is drawn, not its PNG fallback (which holds other
+    # texels); a file without a fallback requires the extension, and loads.
+    write_webp(tmp_path / "checker.webp", TEXELS)
+    mr.write_image(tmp_path / "fallback.png", TEXELS[::-1])
+    path = write_textured_gltf(tmp_path / "webp.gltf", {"uri": "fallback.png"}, NEAREST_CLAMP)
+    doc = json.loads(path.read_text())
+    doc["images"].append({"uri": "checker.webp", "mimeType": "image/webp"})
+    doc["textures"][0]["extensions"] = {"EXT_texture_webp": {"source": 1}}
+    doc["extensionsUsed"] = ["EXT_texture_webp"]
+    if not fallback:
+        del doc["textures"][0]["source"]
+        doc["extensionsRequired"] = ["EXT_texture_webp"]
+    path.write_text(json.dumps(doc))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scene, cameras = mr.load_scene(path)
+    (d,) = scene.draws
+    assert d.texture.name == str(tmp_path / "checker.webp")
+    np.testing.assert_allclose(d.texture.level(0), TEXELS, atol=1e-6)
+    got = quadrant_colors(mr.render(scene, cameras[0], 32, 32).color)
+    for q, expected in enumerate([TEXELS[0, 0], TEXELS[0, 1], TEXELS[1, 0], TEXELS[1, 1]]):
+        np.testing.assert_allclose(got[q], expected, atol=1e-6, err_msg=f"quadrant {q}")
+
+
+@pytest.mark.parametrize("source, words", [(5, "EXT_texture_webp source image 5 does not exist"),
+                                           ("one", "EXT_texture_webp source is not an image index"),
+                                           (-1, "EXT_texture_webp source image -1 is not an image index")])
+def test_gltf_bad_ext_texture_webp_source_is_an_error_naming_it(tmp_path, source, words):
+    path = write_textured_gltf(tmp_path / "bad.gltf", {"uri": "fallback.png"})
+    doc = json.loads(path.read_text())
+    doc["textures"][0]["extensions"] = {"EXT_texture_webp": {"source": source}}
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=r"bad\.gltf: textures\[0\]: " + re.escape(words)):
+        mr.load_scene(path)
+
+
 def test_obj_texture_flips_v(tmp_path):
     write_texture(tmp_path / "checker.png")
     (tmp_path / "m.mtl").write_text("newmtl tex\nKd 1 1 1\nmap_Kd checker.png\n")
@@ -769,7 +813,7 @@ def test_gltf_required_extension_that_is_not_supported_is_named(tmp_path, extens
 
 
 @pytest.mark.parametrize("extension", ["KHR_texture_transform", "KHR_materials_unlit", "KHR_mesh_quantization",
-                                       "EXT_mesh_gpu_instancing"])
+                                       "EXT_mesh_gpu_instancing", "EXT_texture_webp"])
 def test_gltf_required_extension_that_is_supported_loads(tmp_path, extension):
     path = write_gltf(tmp_path / "required_ok.gltf")
     doc = json.loads(path.read_text())

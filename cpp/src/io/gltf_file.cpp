@@ -406,22 +406,40 @@ struct GltfLoader {
         const tinygltf::Texture& tex = model.textures[info.index];
         const std::string tex_what = "textures[" + std::to_string(info.index) + "]";
         Sampler sampler = sampler_of(tex.sampler, tex_what);  // checks the index even when unused below
-        if (tex.source >= 0 && static_cast<std::size_t>(tex.source) >= model.images.size())
-            fail(path, tex_what + ": source image " + std::to_string(tex.source) + " does not exist (the file has " +
-                           std::to_string(model.images.size()) + " images)");
+        const int source = texture_source(tex, tex_what);
         if (!draw.mesh->has_uvs()) {
             warn_once(prim_what + " has no TEXCOORD_" + std::to_string(base_color_uvs(prim.material).set) +
                       " but its " + name +
                       " has a baseColorTexture; drawn without the texture");
             return;
         }
-        if (tex.source < 0) {
+        if (source < 0) {
             warn_once(tex_what + " (used by " + name +
-                      ") has no source image (only extension images such as KTX2/WebP?); drawn without it");
+                      ") has no source image (only extension images such as KTX2 or AVIF?); drawn without it");
             return;
         }
-        draw.texture = image_texture(tex.source, name, /*ignore_alpha=*/!(blend || mask));
+        draw.texture = image_texture(source, name, /*ignore_alpha=*/!(blend || mask));
         draw.sampler = sampler;
+    }
+
+    /// The image a texture draws: its EXT_texture_webp source where it has one (that extension asks
+    /// clients that read WebP to prefer it; the core source is then a PNG or JPEG fallback, or
+    /// absent), else its core source; −1 for none. An index that does not exist is an error.
+    int texture_source(const tinygltf::Texture& tex, const std::string& tex_what) {
+        int source = tex.source;
+        std::string what = tex_what + ": source image ";
+        const auto webp = tex.extensions.find("EXT_texture_webp");
+        if (webp != tex.extensions.end() && webp->second.IsObject() && webp->second.Has("source")) {
+            const tinygltf::Value& v = webp->second.Get("source");
+            if (!v.IsInt()) fail(path, tex_what + ": EXT_texture_webp source is not an image index");
+            source = v.GetNumberAsInt();
+            what = tex_what + ": EXT_texture_webp source image ";
+            if (source < 0) fail(path, what + std::to_string(source) + " is not an image index");
+        }
+        if (source >= 0 && static_cast<std::size_t>(source) >= model.images.size())
+            fail(path, what + std::to_string(source) + " does not exist (the file has " +
+                           std::to_string(model.images.size()) + " images)");
+        return source;
     }
 
     /// glTF sampler → Sampler. Undefined filters keep the library default (trilinear); undefined
@@ -957,10 +975,12 @@ struct GltfLoader {
 
 /// The glTF extensions a file may list in extensionsRequired and still load as its author meant:
 /// those this loader reads (KHR_texture_transform on the base colour texture; KHR_mesh_quantization's
-/// integer POSITION, NORMAL and TEXCOORD_n; EXT_mesh_gpu_instancing's instance transforms) and those
-/// that do not change what it draws (KHR_materials_unlit: its renders are unlit anyway).
-const std::set<std::string> kSupportedRequiredExtensions = {"EXT_mesh_gpu_instancing", "KHR_materials_unlit",
-                                                            "KHR_mesh_quantization", "KHR_texture_transform"};
+/// integer POSITION, NORMAL and TEXCOORD_n; EXT_mesh_gpu_instancing's instance transforms;
+/// EXT_texture_webp's WebP images) and those that do not change what it draws (KHR_materials_unlit:
+/// its renders are unlit anyway).
+const std::set<std::string> kSupportedRequiredExtensions = {"EXT_mesh_gpu_instancing", "EXT_texture_webp",
+                                                            "KHR_materials_unlit", "KHR_mesh_quantization",
+                                                            "KHR_texture_transform"};
 
 /// Extensions in extensionsUsed that cannot change this loader's unlit base-colour render, or whose
 /// fallback it draws, so they get no warning: compressed geometry (a file that only uses it carries
@@ -971,7 +991,7 @@ const std::set<std::string> kSupportedRequiredExtensions = {"EXT_mesh_gpu_instan
 /// (KHR_materials_*, see unapplied_extension_effect) are matched by prefix.
 const std::set<std::string> kInvisibleExtensions = {
     "EXT_instance_features", "EXT_mesh_features", "EXT_mesh_manifold", "EXT_meshopt_compression",
-    "EXT_structural_metadata", "EXT_texture_avif", "EXT_texture_webp", "KHR_animation_pointer",
+    "EXT_structural_metadata", "EXT_texture_avif", "KHR_animation_pointer",
     "KHR_draco_mesh_compression", "KHR_meshopt_compression", "KHR_texture_basisu", "KHR_xmp", "KHR_xmp_json_ld",
     "MSFT_lod", "MSFT_packing_normalRoughnessMetallic", "MSFT_packing_occlusionRoughnessMetallic",
     "MSFT_texture_dds"};
