@@ -763,12 +763,19 @@ TEST(SceneFileTextures, MissingOrCorruptTextureGivesErrorTextureAndWarning) {
     EXPECT_EQ(sd.draws[0].texture.name(), "error texture");
     EXPECT_TRUE(has_warning(sd, {"material 'textured'", "images[0]"})) << warnings_text(sd);
 
-    TexturedGltf w;  // a data URI of a media type tinygltf does not take as data
+    TexturedGltf w;  // a data URI of a media type tinygltf does not take as data, holding no image
     w.images = R"([{"uri": "data:image/webp;base64,AAAA"}])";
     const auto sw = mr::load_scene(w.write("webp_data_uri.gltf"));
     EXPECT_EQ(sw.draws[0].texture.name(), "error texture");
-    EXPECT_TRUE(has_warning(sw, {"material 'textured'", "images[0]", "'image/webp' is not supported"}))
-        << warnings_text(sw);
+    EXPECT_TRUE(has_warning(sw, {"material 'textured'", "images[0] (data URI)"})) << warnings_text(sw);
+
+    for (const char* uri : {"data:image/webp,AAAA", "data:image/webp;base64,AA*A", "data:image/webp;base64,A"}) {
+        TexturedGltf b;  // not base64
+        b.images = std::string(R"([{"uri": ")") + uri + R"("}])";
+        const auto sb = mr::load_scene(b.write("bad_data_uri.gltf"));
+        EXPECT_EQ(sb.draws[0].texture.name(), "error texture") << uri;
+        EXPECT_TRUE(has_warning(sb, {"images[0] (data URI)", "is not a base64 data URI"})) << uri << warnings_text(sb);
+    }
 }
 
 TEST(SceneFileTextures, UnusableTexturesAreWarnedAndSkipped) {

@@ -268,6 +268,19 @@ def test_gltf_bad_ext_texture_webp_source_is_an_error_naming_it(tmp_path, source
         mr.load_scene(path)
 
 
+def test_gltf_data_uri_of_any_image_type_is_decoded(tmp_path):
+    # tinygltf decodes PNG, JPEG, BMP and GIF data URIs; the loader decodes the others (here WebP)
+    # itself. Unpadded base64 too.
+    webp = write_webp(tmp_path / "src.webp", TEXELS).read_bytes()
+    for padding in (True, False):
+        text = base64.b64encode(webp).decode()
+        image = {"uri": "data:image/webp;base64," + (text if padding else text.rstrip("="))}
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            scene, _ = mr.load_scene(write_textured_gltf(tmp_path / "embedded.gltf", image))
+        np.testing.assert_allclose(scene.draws[0].texture.level(0), TEXELS, atol=1e-6)
+
+
 def test_obj_texture_flips_v(tmp_path):
     write_texture(tmp_path / "checker.png")
     (tmp_path / "m.mtl").write_text("newmtl tex\nKd 1 1 1\nmap_Kd checker.png\n")

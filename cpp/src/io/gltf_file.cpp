@@ -20,6 +20,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -53,6 +54,35 @@ bool keep_data_uri_image(tinygltf::Image* image, const int index, std::string*, 
                          const unsigned char* bytes, int size, void* user) {
     if (image->uri.empty() && image->bufferView < 0 && bytes != nullptr && size > 0)
         static_cast<EmbeddedImages*>(user)->bytes[index].assign(bytes, bytes + size);
+    return true;
+}
+
+/// The bytes of base64 `text` (RFC 4648, with or without '=' padding); false where it holds
+/// another character or a dangling one.
+bool decode_base64(std::string_view text, std::vector<unsigned char>& out) {
+    while (!text.empty() && text.back() == '=') text.remove_suffix(1);
+    out.clear();
+    out.reserve(text.size() / 4 * 3 + 2);
+    std::uint32_t bits = 0;
+    int count = 0;
+    for (const char c : text) {
+        const int v = c >= 'A' && c <= 'Z'   ? c - 'A'
+                      : c >= 'a' && c <= 'z' ? c - 'a' + 26
+                      : c >= '0' && c <= '9' ? c - '0' + 52
+                      : c == '+'             ? 62
+                      : c == '/'             ? 63
+                                             : -1;
+        if (v < 0) return false;
+        bits = bits << 6 | static_cast<std::uint32_t>(v);
+        if (++count == 4) {
+            out.insert(out.end(), {static_cast<unsigned char>(bits >> 16), static_cast<unsigned char>(bits >> 8),
+                                   static_cast<unsigned char>(bits)});
+            bits = 0, count = 0;
+        }
+    }
+    if (count == 1) return false;
+    if (count >= 2) out.push_back(static_cast<unsigned char>(bits >> (count == 2 ? 4 : 10)));
+    if (count == 3) out.push_back(static_cast<unsigned char>(bits >> 2));
     return true;
 }
 
@@ -519,13 +549,17 @@ struct GltfLoader {
         if (image.uri.empty() && image.bufferView >= 0)
             buffer_view_bytes(image.bufferView, what, view_bytes, view_size);  // a bad view is an error, not a warning
         try {
-            if (!image.uri.empty()) {
-                if (image.uri.rfind("data:", 0) == 0) {  // tinygltf decodes PNG, JPEG, BMP and GIF data URIs only
-                    source = what + " (data URI)";
-                    const std::size_t type_end = std::min<std::size_t>(image.uri.find_first_of(";,"), 64);
-                    const std::string type = image.uri.substr(5, type_end - 5);
-                    throw std::runtime_error("data URI of media type '" + type + "' is not supported");
-                }
+            if (image.uri.rfind("data:", 0) == 0) {  // tinygltf decodes PNG, JPEG, BMP and GIF data URIs only
+                source = what + " (data URI)";
+                const std::size_t comma = image.uri.find(',');
+                const std::string header = image.uri.substr(0, std::min<std::size_t>(comma, 64));
+                std::vector<unsigned char> bytes;
+                if (comma == std::string::npos || header.size() < 7 ||
+                    header.compare(header.size() - 7, 7, ";base64") != 0 ||
+                    !decode_base64(std::string_view(image.uri).substr(comma + 1), bytes))
+                    throw std::runtime_error("'" + header + "' is not a base64 data URI");
+                texture = load_texture_from_memory(bytes.data(), bytes.size(), path + " " + what, options);
+            } else if (!image.uri.empty()) {
                 const std::string uri = percent_decode(image.uri);
                 source = "'" + uri + "'";
                 if (uri.find("://") != std::string::npos)
