@@ -78,6 +78,14 @@ inline mr::DrawState no_depth(mr::BlendMode blend = mr::BlendMode::replace) {
     return st;
 }
 
+/// A depth-tested state with alpha testing at `cutoff`, its depth written or only read.
+inline mr::DrawState alpha_tested(float cutoff, bool depth_write) {
+    mr::DrawState st;
+    st.alpha_cutoff = cutoff;
+    st.depth_write = depth_write;
+    return st;
+}
+
 inline mr::Draw make_draw(const mr::Mesh& mesh, const glm::dmat4& model, const mr::DrawState& state,
                           glm::vec4 color = glm::vec4(1.0f)) {
     mr::Draw d;

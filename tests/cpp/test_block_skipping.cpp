@@ -167,9 +167,7 @@ TEST(BlockSkipping, AlphaTestedDrawsSkipBlocksWithThePlainPathsBitsAndCounters) 
     for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
         const mr::Camera cam = overlap_camera(convention, W, H);
         for (bool depth_write : {true, false}) {
-            mr::DrawState masked;
-            masked.alpha_cutoff = 0.6f;
-            masked.depth_write = depth_write;
+            const mr::DrawState masked = alpha_tested(0.6f, depth_write);
             std::vector<mr::Draw> draws = {make_draw(a, glm::dmat4(1.0), {}), make_draw(b, glm::dmat4(1.0), masked),
                                            make_draw(textured, glm::dmat4(1.0), masked)};
             draws[2].texture = checker_texture();

@@ -107,9 +107,7 @@ TEST(SampleRows, AlphaTestedRowsGiveThePerSampleBits) {
     for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
         const mr::Camera cam = overlap_camera(convention, W, H);
         for (bool depth_write : {true, false}) {
-            mr::DrawState masked;
-            masked.alpha_cutoff = 0.6f;
-            masked.depth_write = depth_write;
+            const mr::DrawState masked = alpha_tested(0.6f, depth_write);
             std::vector<mr::Draw> draws = {make_draw(b, shifted, mr::DrawState()),
                                            make_draw(a, glm::dmat4(1.0), masked), make_draw(b, glm::dmat4(1.0), masked),
                                            make_draw(a, shifted, mr::DrawState(), glm::vec4(0.3f, 0.9f, 0.4f, 1.0f))};
