@@ -63,6 +63,62 @@ TEST(Renderer, SetUpRecordsStoredPastTheCacheGiveTheSameImage) {
         }
 }
 
+// Draws of fewer triangles than a chunk's minimum share chunks (a tile's list then changes draw
+// in runs): 200 three-triangle draws of mixed states (textured or not, replace or over, depth
+// written or not, alpha-tested) give the bits and counters they give when each is padded with
+// 300 triangles off the screen, which makes it a chunk of its own.
+TEST(Renderer, SmallDrawsSharingChunksDrawAsDrawsOfTheirOwnChunks) {
+    const int W = 96, H = 80;
+    const std::size_t kDraws = 200, kPadding = 300;
+    const mr::Mesh all = overlapping(3 * kDraws, 1.5, 21);
+    const mr::Texture texture = checker_texture();
+    std::vector<mr::Mesh> small(kDraws), padded(kDraws);
+    for (std::size_t d = 0; d < kDraws; ++d) {
+        for (std::size_t v = 9 * d; v < 9 * d + 9; ++v) {
+            small[d].positions.push_back(all.positions[v]);
+            small[d].colors.push_back(all.colors[v]);
+            small[d].uvs.push_back(all.uvs[v]);
+        }
+        for (std::uint32_t t = 0; t < 3; ++t) add_triangle(small[d], 3 * t, 3 * t + 1, 3 * t + 2);
+        padded[d] = small[d];
+        for (std::size_t t = 0; t < kPadding; ++t) {
+            const auto first = static_cast<std::uint32_t>(padded[d].positions.size());
+            for (const glm::vec3& p : {glm::vec3(1000, 0, 0), glm::vec3(1001, 0, 0), glm::vec3(1000, 1, 0)}) {
+                padded[d].positions.push_back(p);
+                padded[d].colors.push_back(glm::vec4(1.0f));
+                padded[d].uvs.push_back(glm::vec2(0.0f));
+            }
+            add_triangle(padded[d], first, first + 1, first + 2);
+        }
+    }
+    const auto scene = [&](const std::vector<mr::Mesh>& meshes) {
+        std::vector<mr::Draw> draws;
+        for (std::size_t d = 0; d < kDraws; ++d) {
+            mr::DrawState state;
+            state.blend = d % 2 ? mr::BlendMode::over : mr::BlendMode::replace;
+            state.depth_write = d % 7 != 3;
+            if (d % 5 == 4) state.alpha_cutoff = 0.6f;
+            draws.push_back(make_draw(meshes[d], glm::dmat4(1.0), state));
+            if (d % 3 == 0) draws.back().texture = texture;
+        }
+        return draws;
+    };
+    const mr::Camera cam = overlap_camera(mr::DepthConvention::reverse_z, W, H);
+    for (int threads : {1, 2})
+        for (const auto& [samples, aa] : {std::pair{1, mr::AntiAliasing::ssaa}, std::pair{4, mr::AntiAliasing::msaa},
+                                          std::pair{4, mr::AntiAliasing::ssaa}}) {
+            SCOPED_TRACE(std::to_string(threads) + " threads, " + std::to_string(samples) + " " + mr::to_string(aa));
+            auto s = settings(W, H, samples);
+            s.anti_aliasing = aa;
+            s.threads = threads;
+            const mr::RenderResult shared = mr::render(scene(small), cam, s), own = mr::render(scene(padded), cam, s);
+            expect_same_render(shared, own);
+            EXPECT_EQ(own.stats.triangles_outside, shared.stats.triangles_outside + kDraws * kPadding);
+            EXPECT_EQ(own.stats.tiles_deferred, shared.stats.tiles_deferred);
+            EXPECT_GT(shared.stats.samples_passed, std::uint64_t{W} * H);
+        }
+}
+
 TEST(Renderer, OneTwoAndFourThreadsGiveBitIdenticalColourAndDepthForEveryBlendModeSsaaAndMsaa) {
     const int W = 160, H = 120;
     const mr::Camera cam = mr::Camera::look_at_perspective({0.3, 1.0, 4.0}, {0, 0, 0}, {0, 1, 0}, 1.0, double(W) / H, 0.05);

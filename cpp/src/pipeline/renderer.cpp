@@ -34,7 +34,7 @@ double ms_since(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-// A run of one draw's triangles that one task clips, sets up and bins.
+// A run of one draw's triangles; one task clips, sets up and bins a chunk of one or more runs.
 struct ChunkRange {
     std::uint32_t draw, first, last;
 };
@@ -154,17 +154,11 @@ inline void append_streamed(RecycledVector<SetupTriangle>& triangles, const Setu
 #endif
 }
 
-// Clip, set up and bin one chunk of triangles (`streamed`: their records with streaming stores).
-void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices, const ClipVolume& volume,
-                 const Viewport& viewport, const TileGrid& grid, bool overlap_areas, bool streamed, BinnedChunk& chunk,
-                 SetupCounters& counters, std::uint64_t& clipped) {
-    reserve_on_huge_pages(chunk.triangles, range.last - range.first);
-    ChunkBinner binner(chunk, grid, overlap_areas);
-    const auto keep = [&](const SetupTriangle& t) {
-        binner.add(t);
-        if (streamed) append_streamed(chunk.triangles, t);
-        else chunk.triangles.push_back(t);
-    };
+// Clip and set up one run of triangles into `chunk`, each kept through `keep`.
+template <class Keep>
+void setup_range(const ChunkRange& range, const ClipSpaceGeometry& vertices, const ClipVolume& volume,
+                 const Viewport& viewport, BinnedChunk& chunk, SetupCounters& counters, std::uint64_t& clipped,
+                 Keep&& keep) {
     SetupTriangle st;
     ClipPolygon polygon;
     for (std::uint32_t t = range.first; t < range.last; ++t) {
@@ -221,10 +215,29 @@ void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices, con
             }
         }
     }
+}
+
+// Clip, set up and bin one chunk: its runs in order (`streamed`: their records with streaming
+// stores).
+void setup_chunk(const std::vector<ChunkRange>& runs, const std::vector<ClipSpaceGeometry>& geometry,
+                 const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid, bool overlap_areas,
+                 bool streamed, BinnedChunk& chunk, SetupCounters& counters, std::uint64_t& clipped) {
+    std::size_t count = 0;
+    for (const ChunkRange& run : runs) count += run.last - run.first;
+    reserve_on_huge_pages(chunk.triangles, count);
+    ChunkBinner binner(chunk, grid, overlap_areas);
+    const auto keep = [&](const SetupTriangle& t) {
+        binner.add(t);
+        if (streamed) append_streamed(chunk.triangles, t);
+        else chunk.triangles.push_back(t);
+    };
+    for (const ChunkRange& run : runs)
+        setup_range(run, geometry[run.draw], volume, viewport, chunk, counters, clipped, keep);
 #if defined(__SSE2__)
     if (streamed) _mm_sfence();  // (the streaming stores before the hand-off to the threads that rasterize)
 #endif
     binner.finish();
+    chunk.one_draw = runs.size() == 1;
 }
 
 // Stage 2: clip, set up and bin every draw's triangles, in parallel over chunks of consecutive
@@ -233,27 +246,41 @@ void setup_chunk(const ChunkRange& range, const ClipSpaceGeometry& vertices, con
 std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geometry, const ClipVolume& volume,
                                        const Viewport& viewport, const TileGrid& grid, bool overlap_areas,
                                        ThreadPool& pool, RenderStats& stats) {
-    std::vector<ChunkRange> ranges;
+    // Each draw in runs of `size` triangles, a chunk each; the runs of small draws gather into
+    // chunks of up to kMinChunkTriangles (each chunk has a table per tile, and each tile looks at
+    // every chunk: ten thousand two-triangle draws took 13× the time of one draw of them all).
+    std::vector<std::vector<ChunkRange>> runs;
+    std::size_t gathered = kMinChunkTriangles;  // triangles in runs.back() while it gathers
     for (std::uint32_t d = 0; d < geometry.size(); ++d) {
         const std::size_t n = geometry[d].triangles->size();
         stats.triangles_in += n;
         const std::size_t size = std::max(kMinChunkTriangles, n / (4 * static_cast<std::size_t>(pool.size())) + 1);
-        for (std::size_t first = 0; first < n; first += size)
-            ranges.push_back({d, static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(std::min(n, first + size))});
+        for (std::size_t first = 0; first < n; first += size) {
+            const ChunkRange run{d, static_cast<std::uint32_t>(first),
+                                 static_cast<std::uint32_t>(std::min(n, first + size))};
+            const std::size_t count = run.last - run.first;
+            if (count < kMinChunkTriangles && gathered + count <= kMinChunkTriangles) {
+                runs.back().push_back(run);
+                gathered += count;
+            } else {
+                runs.push_back({run});
+                gathered = count;
+            }
+        }
     }
     const bool streamed = stats.triangles_in * sizeof(SetupTriangle) > kStreamedSetupBytes;
-    std::vector<BinnedChunk> chunks(ranges.size());
-    std::vector<SetupCounters> setup_counters(ranges.size());
-    std::vector<std::uint64_t> clipped(ranges.size(), 0);
-    pool.parallel_for(ranges.size(), [&](std::size_t i) {
+    std::vector<BinnedChunk> chunks(runs.size());
+    std::vector<SetupCounters> setup_counters(runs.size());
+    std::vector<std::uint64_t> clipped(runs.size(), 0);
+    pool.parallel_for(runs.size(), [&](std::size_t i) {
         SetupCounters counters;  // (stored once: neighbouring chunks' counters share cache lines)
         std::uint64_t clipped_here = 0;
-        setup_chunk(ranges[i], geometry[ranges[i].draw], volume, viewport, grid, overlap_areas, streamed, chunks[i],
-                    counters, clipped_here);
+        setup_chunk(runs[i], geometry, volume, viewport, grid, overlap_areas, streamed, chunks[i], counters,
+                    clipped_here);
         setup_counters[i] = counters;
         clipped[i] = clipped_here;
     });
-    for (std::size_t i = 0; i < ranges.size(); ++i) {
+    for (std::size_t i = 0; i < runs.size(); ++i) {
         stats.triangles_clipped += clipped[i];
         stats.triangles_outside += setup_counters[i].culled_outside;
         stats.triangles_backface += setup_counters[i].culled_backface;
@@ -264,19 +291,31 @@ std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geo
     return chunks;
 }
 
-// Stage 3 for one tile: every chunk's triangles that touch it, in submission order. A chunk
-// holds one draw's triangles: one kernel call per chunk and tile.
+// Calls f(draw, begin, end) for each run of one draw's triangles in the chunk's list for `tile`
+// (submission order): the whole list where the chunk holds one draw.
+template <class F>
+void for_each_draw_run(const BinnedChunk& chunk, std::size_t tile, F&& f) {
+    const std::uint32_t* begin = chunk.tile_triangles.data() + chunk.tile_start[tile];
+    const std::uint32_t* const end = chunk.tile_triangles.data() + chunk.tile_start[tile + 1];
+    while (begin != end) {
+        const std::uint32_t draw = chunk.triangles[*begin].draw;
+        const std::uint32_t* run = chunk.one_draw ? end : begin + 1;
+        while (run != end && chunk.triangles[*run].draw == draw) ++run;
+        f(draw, begin, run);
+        begin = run;
+    }
+}
+
+// Stage 3 for one tile: every chunk's triangles that touch it, in submission order: one kernel
+// call per run of one draw's triangles.
 void rasterize_tile_chunks(std::size_t tile, const std::vector<BinnedChunk>& chunks, const std::vector<TileKernel>& kernels,
                            const std::vector<DrawInputs>& inputs, const TileTarget& target, TileCounters& counters) {
-    for (const BinnedChunk& chunk : chunks) {
-        const std::uint32_t* begin = chunk.tile_triangles.data() + chunk.tile_start[tile];
-        const std::uint32_t* end = chunk.tile_triangles.data() + chunk.tile_start[tile + 1];
-        if (begin == end) continue;
-        const std::uint32_t draw = chunk.triangles[*begin].draw;
-        const TriangleBatch batch{chunk.triangles.data(), begin, static_cast<std::size_t>(end - begin),
-                                  chunk.clip_weights.data()};
-        kernels[draw](target, inputs[draw], batch, counters);
-    }
+    for (const BinnedChunk& chunk : chunks)
+        for_each_draw_run(chunk, tile, [&](std::uint32_t draw, const std::uint32_t* begin, const std::uint32_t* end) {
+            const TriangleBatch batch{chunk.triangles.data(), begin, static_cast<std::size_t>(end - begin),
+                                      chunk.clip_weights.data()};
+            kernels[draw](target, inputs[draw], batch, counters);
+        });
 }
 
 // Whether any triangle's bounds reach the tile.
@@ -312,11 +351,13 @@ bool defer_tile(std::size_t tile, const std::vector<BinnedChunk>& chunks, const 
     if (overdraw < kDeferredMinOverdraw) return false;
     if (!every_draw && !tile_deferrable(tile, chunks, deferrable)) return false;
     std::size_t triangles = 0;
-    for (const BinnedChunk& chunk : chunks) {
-        const std::uint32_t first = chunk.tile_start[tile], count = chunk.tile_start[tile + 1] - first;
-        if (count && inputs[chunk.triangles[chunk.tile_triangles[first]].draw].texture) return true;
-        triangles += count;
-    }
+    bool textured = false;
+    for (const BinnedChunk& chunk : chunks)
+        for_each_draw_run(chunk, tile, [&](std::uint32_t draw, const std::uint32_t* begin, const std::uint32_t* end) {
+            textured = textured || inputs[draw].texture;
+            triangles += static_cast<std::size_t>(end - begin);
+        });
+    if (textured) return true;
     const double tile_area = double(target.x1 - target.x0) * double(target.y1 - target.y0);
     const double mean_area = overdraw * tile_area / double(triangles);  // (overdraw > 0: some triangle)
     return (overdraw - 1.0) * (overdraw - 1.0) * mean_area >= kDeferredMinUntexturedGain;

@@ -17,7 +17,8 @@ struct TileGrid {
     int count() const { return tiles_x * tiles_y; }
 };
 
-/// One contiguous run of submitted triangles after setup, with its per-tile lists (CSR layout:
+/// Runs of submitted triangles after setup (one draw's, or several small draws'), with their
+/// per-tile lists (CSR layout:
 /// the triangles touching tile i are tile_triangles[tile_start[i] … tile_start[i+1]), ascending).
 /// Processing chunks in order and each tile list in order is submission order, however the
 /// triangles were split into chunks. (On cache lines of its own: threads set up neighbouring
@@ -31,6 +32,7 @@ struct alignas(kBlockAlignment) BinnedChunk {
     /// Per tile, about how many pixels of it the chunk's triangles cover, overlaps counted again
     /// (tile_overlap_area): what deciding on deferred shading sums. Empty when not asked for.
     std::vector<double> tile_area;
+    bool one_draw = true;  ///< every triangle is of one draw (else a tile's list changes draw in runs)
 };
 
 /// About how many pixels of the rectangle [x0, x1) × [y0, y1) t covers: all of them when t holds
