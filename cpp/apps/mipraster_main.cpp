@@ -237,7 +237,8 @@ struct RenderOptions {
     std::string scene;  ///< scene file; empty: the built-in demo
     int camera = -1;    ///< --camera N; −1: not given
     std::string output;
-    std::string bits = "8";  ///< --bits, checked against the output once both are known
+    std::string bits = "8";  ///< --bits as given, checked against the output once both are known
+    ImageWriteOptions write;  ///< from --bits
     RenderSettings settings;
     bool print_stats = false;
     std::string stats_json;  ///< path, "-" for stdout, empty for none
@@ -375,7 +376,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     if (o.camera >= 0 && o.scene.empty())
         throw UsageError("--camera: needs a scene file (the built-in demo has one camera)");
     if (o.output.empty()) throw UsageError("render: missing -o PATH (where to write the image)");
-    parse_bits(o.bits, o.output);
+    o.write = parse_bits(o.bits, o.output);
     if (!o.error_map.empty() && o.settings.samples < 2)
         throw UsageError("--error-map: the estimate compares two halves of each pixel's samples; give --spp 2 or more");
     return o;
@@ -449,7 +450,7 @@ int run_render(const std::vector<std::string>& args) {
             result.error_estimate = summarize_error_map(result.error_map);
         }
     }
-    write_image(o.output, result.color, parse_bits(o.bits, o.output));
+    write_image(o.output, result.color, o.write);
     if (!o.quiet)
         std::printf("wrote %s (%dx%d, %d spp %s, %.1f ms on %d threads)\n", o.output.c_str(), settings.width,
                     settings.height, settings.samples, to_string(settings.anti_aliasing).c_str(), result.stats.total_ms,
@@ -494,7 +495,8 @@ std::pair<int, int> parse_size(const std::string& text, int limit) {
 // The options shared by resize and synthesize: one input, -o OUT, --size, --threads, --quiet;
 // `extra` handles the command's own options (returns false for an unknown one).
 struct ImageCommand {
-    std::string input, output, bits = "8";
+    std::string input, output, bits = "8";  // (bits: --bits as given)
+    ImageWriteOptions write;                 // from --bits
     int width = 0, height = 0, threads = 0;
     bool quiet = false;
 };
@@ -531,7 +533,7 @@ ImageCommand parse_image_command(const char* command, const std::vector<std::str
     }
     if (o.input.empty()) throw UsageError(std::string(command) + ": missing the input image");
     if (o.output.empty()) throw UsageError(std::string(command) + ": missing -o PATH (where to write the image)");
-    parse_bits(o.bits, o.output);
+    o.write = parse_bits(o.bits, o.output);
     if (o.width == 0) throw UsageError(std::string(command) + ": missing --size WxH");
     return o;
 }
@@ -547,7 +549,7 @@ int run_resize(const std::vector<std::string>& args) {
     const auto start = std::chrono::steady_clock::now();
     const Image out = resample(image, o.width, o.height, filter, o.threads);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    write_image(o.output, out, parse_bits(o.bits, o.output));
+    write_image(o.output, out, o.write);
     if (!o.quiet)
         std::printf("wrote %s (%dx%d from %dx%d, %s, %.1f ms)\n", o.output.c_str(), o.width, o.height, image.width,
                     image.height, to_string(filter).c_str(), ms);
@@ -576,7 +578,7 @@ int run_synthesize(const std::vector<std::string>& args) {
         throw std::invalid_argument("--window " + std::to_string(settings.window) + ": larger than the sample " +
                                     o.input + " (" + std::to_string(sample.width) + "x" + std::to_string(sample.height) + ")");
     const SynthesisResult r = synthesize_texture(sample, settings);
-    write_image(o.output, r.image, parse_bits(o.bits, o.output));
+    write_image(o.output, r.image, o.write);
     if (!o.quiet)
         std::printf("wrote %s (%dx%d from %s, window %d, seed %llu, %.1f ms)\n", o.output.c_str(), o.width, o.height,
                     o.input.c_str(), settings.window, static_cast<unsigned long long>(settings.seed), r.milliseconds);

@@ -249,8 +249,8 @@ std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geo
     // Each draw in runs of `size` triangles, a chunk each; the runs of small draws gather into
     // chunks of up to kMinChunkTriangles (each chunk has a table per tile, and each tile looks at
     // every chunk: ten thousand two-triangle draws took 13× the time of one draw of them all).
-    std::vector<std::vector<ChunkRange>> runs;
-    std::size_t gathered = kMinChunkTriangles;  // triangles in runs.back() while it gathers
+    std::vector<std::vector<ChunkRange>> chunk_runs;  // each chunk's runs
+    std::size_t gathered = kMinChunkTriangles;        // triangles in chunk_runs.back() while it gathers
     for (std::uint32_t d = 0; d < geometry.size(); ++d) {
         const std::size_t n = geometry[d].triangles->size();
         stats.triangles_in += n;
@@ -260,27 +260,27 @@ std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geo
                                  static_cast<std::uint32_t>(std::min(n, first + size))};
             const std::size_t count = run.last - run.first;
             if (count < kMinChunkTriangles && gathered + count <= kMinChunkTriangles) {
-                runs.back().push_back(run);
+                chunk_runs.back().push_back(run);
                 gathered += count;
             } else {
-                runs.push_back({run});
+                chunk_runs.push_back({run});
                 gathered = count;
             }
         }
     }
     const bool streamed = stats.triangles_in * sizeof(SetupTriangle) > kStreamedSetupBytes;
-    std::vector<BinnedChunk> chunks(runs.size());
-    std::vector<SetupCounters> setup_counters(runs.size());
-    std::vector<std::uint64_t> clipped(runs.size(), 0);
-    pool.parallel_for(runs.size(), [&](std::size_t i) {
+    std::vector<BinnedChunk> chunks(chunk_runs.size());
+    std::vector<SetupCounters> setup_counters(chunk_runs.size());
+    std::vector<std::uint64_t> clipped(chunk_runs.size(), 0);
+    pool.parallel_for(chunk_runs.size(), [&](std::size_t i) {
         SetupCounters counters;  // (stored once: neighbouring chunks' counters share cache lines)
         std::uint64_t clipped_here = 0;
-        setup_chunk(runs[i], geometry, volume, viewport, grid, overlap_areas, streamed, chunks[i], counters,
+        setup_chunk(chunk_runs[i], geometry, volume, viewport, grid, overlap_areas, streamed, chunks[i], counters,
                     clipped_here);
         setup_counters[i] = counters;
         clipped[i] = clipped_here;
     });
-    for (std::size_t i = 0; i < runs.size(); ++i) {
+    for (std::size_t i = 0; i < chunk_runs.size(); ++i) {
         stats.triangles_clipped += clipped[i];
         stats.triangles_outside += setup_counters[i].culled_outside;
         stats.triangles_backface += setup_counters[i].culled_backface;
