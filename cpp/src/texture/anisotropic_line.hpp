@@ -15,6 +15,9 @@ namespace mipraster {
 /// not and log2_pmax is given, *log2_pmax is log2 Pmax (null: the log2 is skipped where it can be).
 bool anisotropic_magnifies(double pmax2, const Sampler& sampler, int levels, double* log2_pmax = nullptr);
 
+/// The most probes a line of a sampler with this max_anisotropy takes (anisotropic_probe_count's cap).
+int most_probes(float max_anisotropy);
+
 /// How far from the origin a line's probes may reach (texels) for their indices to be worked out
 /// in int: ⌊x⌋ + 1 fits, with room for wrapping.
 inline constexpr double kProbeReach = 0x1p30;

@@ -530,10 +530,14 @@ const GaussianTable kGaussian;
 
 }  // namespace
 
+int most_probes(float max_anisotropy) {
+    // max_anisotropy is any finite float ≥ 1: bound it before the int conversion (UB beyond 2³¹).
+    return static_cast<int>(std::clamp(double(max_anisotropy), 1.0, double(kMostProbes)));
+}
+
 int anisotropic_probe_count(double px2, double py2, float max_anisotropy) {
     const double pmax2 = std::max(px2, py2), pmin2 = std::min(px2, py2);
-    // max_anisotropy is any finite float ≥ 1: bound it before the int conversion (UB beyond 2³¹).
-    const int max_n = static_cast<int>(std::clamp(double(max_anisotropy), 1.0, double(kMostProbes)));
+    const int max_n = most_probes(max_anisotropy);
     // ⌈Pmax/Pmin⌉ from the squares; Pmin = 0 gives ∞ or NaN, both max_n.
     if (pmax2 == pmin2 && pmin2 > 0.0) return 1;  // isotropic: neither the division nor the root
     const double ratio2 = pmax2 / pmin2;
