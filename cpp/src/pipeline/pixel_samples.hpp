@@ -39,14 +39,15 @@ struct DepthPlane4 {
 
 /// The depth test of four samples at screen weights l1, l2 (edges 1 and 2) against depth[0 … 3],
 /// at the lanes of `lanes` (bit k: sample k): z = z0 + l1·dz1 + l2·dz2 rounded to float, as
-/// sample_depth computes it; the passing depths are stored when depth_write. Returns the lanes
-/// that passed.
+/// sample_depth computes it; the passing depths are stored when depth_write, and all four into
+/// computed[0 … 3] where it is not null. Returns the lanes that passed.
 [[gnu::always_inline]] [[gnu::target("avx2")]] inline std::uint32_t test_four_depths(
     const DepthPlane4& plane, __m256d l1, __m256d l2, std::uint32_t lanes, DepthFunc func, bool depth_write,
-    float* depth) {
+    float* depth, float* computed = nullptr) {
     const __m128i lane_bit = _mm_setr_epi32(1, 2, 4, 8);
     const __m128 z = _mm256_cvtpd_ps(
         _mm256_add_pd(_mm256_add_pd(plane.z0, _mm256_mul_pd(l1, plane.dz1)), _mm256_mul_pd(l2, plane.dz2)));
+    if (computed) _mm_storeu_ps(computed, z);
     const __m128 stored = _mm_loadu_ps(depth);
     const __m128 asked = _mm_castsi128_ps(
         _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(lanes)), lane_bit), lane_bit));

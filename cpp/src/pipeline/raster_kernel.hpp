@@ -4,6 +4,7 @@
 // of texturing is instantiated in its own source file so they compile in parallel.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <optional>
 
 #include "mipraster/core/constants.hpp"
@@ -132,8 +133,10 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
 
     // Samples `samples` of pixel (px, py), shaded at screen weights l with colour c: discarded, or
     // counted as passed, their colour written and (depth_write) the depths their tests computed:
-    // from l where it is the sample's own (one sample shaded), else from the sample's position.
-    const auto test_and_write = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l, glm::vec4 c) {
+    // from l where it is the sample's own (one sample shaded), else `depths` (sample s's at
+    // depths[s]) where the vector row test kept them, else from the sample's position.
+    const auto test_and_write = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l, glm::vec4 c,
+                                    const float* depths) {
         if (!alpha_test(c, *draw.alpha_cutoff)) return;
         if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
         if constexpr (kMode != SampleMode::msaa) {
@@ -146,20 +149,25 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
         if (kDepth != DepthFunc::none && draw.depth_write) {
             float* const depth_px = target.depth.at(px, py, 0);
             std::int64_t p[3];
-            corner(px, py, p);
-            for (std::uint64_t m = samples; m; m &= m - 1)
-                depth_px[__builtin_ctzll(m)] = sample_depth(t, weights_at(p, __builtin_ctzll(m)));
+            if (!depths) corner(px, py, p);
+            for (std::uint64_t m = samples; m; m &= m - 1) {
+                const int s = __builtin_ctzll(m);
+                depth_px[s] = depths ? depths[s] : sample_depth(t, weights_at(p, s));
+            }
         }
         float* const color_px = target.color.at(px, py, 0);
         for (std::uint64_t m = samples; m; m &= m - 1) blend_into<kBlend>(color_px + 4 * __builtin_ctzll(m), c);
     };
-    // The shades waiting for a batch (with `sampler`): pixel and samples (screen weights in `weights`).
+    // The shades waiting for a batch (with `sampler`): pixel and samples (screen weights in `weights`,
+    // and where tested_depths, the samples' depths in waiting_depths).
     struct Waiting {
         int px, py;
         std::uint64_t samples;
+        bool tested_depths;
     };
     BatchWeights weights;
     Waiting waiting[kLookupBatch];
+    float waiting_depths[kMode == SampleMode::msaa ? kLookupBatch : 1][kMaxSamples];
     LookupBatch lookups;
     const bool batched = sampler && interpolates_in_batches(draw, kShading, kTexturing, t);
     const Shading shading = batch_shading(kShading, colors);
@@ -179,31 +187,39 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
             lookups.count = n;
         }
         sampler->sample(lookups, texel);
-        for (int i = 0; i < n; ++i)
+        for (int i = 0; i < n; ++i) {
+            const float* const depths = kMode == SampleMode::msaa && waiting[i].tested_depths ? waiting_depths[i] : nullptr;
             test_and_write(waiting[i].px, waiting[i].py, waiting[i].samples,
-                           glm::dvec3(weights.l0[i], weights.l1[i], weights.l2[i]), colour[i] * texel[i]);
+                           glm::dvec3(weights.l0[i], weights.l1[i], weights.l2[i]), colour[i] * texel[i], depths);
+        }
         weights.count = 0;
     };
-    // Shades samples `samples` of pixel (px, py) at screen weights l.
-    const auto shade_samples = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l) {
+    // Shades samples `samples` of pixel (px, py) at screen weights l (MSAA: their tested depths
+    // at depths[s], or null).
+    const auto shade_samples = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l,
+                                   const float* depths = nullptr) {
         ++counters.shader_invocations;
         if (!sampler) {
             const glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, l, clip_weights, px, py);
-            test_and_write(px, py, samples, l, c);
+            test_and_write(px, py, samples, l, c, depths);
             return;
         }
         const int i = weights.count++;
         weights.l0[i] = l.x, weights.l1[i] = l.y, weights.l2[i] = l.z;
-        waiting[i] = {px, py, samples};
+        waiting[i] = {px, py, samples, depths != nullptr};
+        if (kMode == SampleMode::msaa && depths) std::memcpy(waiting_depths[i], depths, sizeof(float) * S);
         if (weights.count == kLookupBatch) shade_waiting();
     };
-    // MSAA shades samples `passed` of pixel (px, py), whose corner has edge values p, once.
-    const auto shade_pixel = [&](int px, int py, std::uint64_t passed, const std::int64_t (&p)[3]) {
+    // MSAA shades samples `passed` of pixel (px, py), whose corner has edge values p, once (their
+    // tested depths at depths[s], or null).
+    const auto shade_pixel = [&](int px, int py, std::uint64_t passed, const std::int64_t (&p)[3],
+                                 const float* depths = nullptr) {
         const std::int64_t c0 = p[0] + (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * (kStep / 2);
         const std::int64_t c1 = p[1] + (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * (kStep / 2);
         const std::int64_t c2 = p[2] + (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * (kStep / 2);
         shade_samples(px, py, passed,
-                      (c0 | c1 | c2) >= 0 ? screen_weights(t, c0, c1, c2) : weights_at(p, __builtin_ctzll(passed)));
+                      (c0 | c1 | c2) >= 0 ? screen_weights(t, c0, c1, c2) : weights_at(p, __builtin_ctzll(passed)),
+                      depths);
     };
 
     // A long depth-tested row of pixels [rx0, rx0 + n), tested a vector at a time: false (nothing
@@ -221,14 +237,15 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
                 if (S % 4 != 0 || BatchSampler::widest_vector() != 8 || blocks.row_pixels(classified, py, rx0, n))
                     return false;
                 std::uint64_t samples[kTileSize];
+                float depths[kTileSize * kMaxSamples];  // (the write takes them, not computes them again)
                 const double* const by_sample[3] = {offsets[0], offsets[1], offsets[2]};
                 counters.samples_covered += test_pixel_row_avx2(t, row, n, by_sample, S, kDepth, false,
-                                                                target.depth.at(rx0, py, 0), samples);
+                                                                target.depth.at(rx0, py, 0), samples, depths);
                 for (int j = 0; j < n; ++j) {
                     if (!samples[j]) continue;
                     std::int64_t p[3];
                     for (int i = 0; i < 3; ++i) p[i] = row[i] + j * std::int64_t{t.edge_a[i]} * kStep;
-                    shade_pixel(rx0 + j, py, samples[j], p);
+                    shade_pixel(rx0 + j, py, samples[j], p, depths + j * S);
                 }
             } else {
                 const std::uint32_t skipped = blocks.row_pixels(cls.skipped, py, rx0, n);

@@ -178,7 +178,7 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
 [[gnu::target("avx2")]] std::uint64_t test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&corner)[3],
                                                           int n, const double* const (&offsets)[3], int S,
                                                           DepthFunc func, bool depth_write, float* depth,
-                                                          std::uint64_t* samples) {
+                                                          std::uint64_t* samples, float* tested_depths) {
     __m256d first[3], step[3], bias[3];
     for (int i = 0; i < 3; ++i) {
         first[i] = _mm256_set1_pd(static_cast<double>(corner[i] + t.bias[i]));
@@ -204,8 +204,9 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
             covered_samples += static_cast<std::uint64_t>(__builtin_popcount(lanes));
             if (!lanes) continue;
             const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
-            float* const stored = depth + static_cast<std::ptrdiff_t>(j) * S + g;
-            passed |= std::uint64_t{test_four_depths(plane, l1, l2, lanes, func, depth_write, stored)} << g;
+            const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(j) * S + g;
+            float* const tested = tested_depths ? tested_depths + at : nullptr;
+            passed |= std::uint64_t{test_four_depths(plane, l1, l2, lanes, func, depth_write, depth + at, tested)} << g;
         }
         samples[j] = passed;
     }

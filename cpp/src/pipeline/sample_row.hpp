@@ -47,11 +47,13 @@ bool test_sample_row_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], in
 /// edge values `corner` (bias not added; sample_rows_exact must hold), a pixel's S samples (a
 /// multiple of 4) four per vector: sample s moves edge i from the corner by offsets[i][s]. Tests
 /// depth (less or greater) at the covered samples against depth[j·S + s], storing the passing
-/// depths when depth_write; samples[j] gets pixel j's passed samples. Returns how many samples
-/// are covered. The per-sample path's bits (as test_sample_row); needs AVX2.
+/// depths when depth_write; samples[j] gets pixel j's passed samples. Where tested_depths is not
+/// null, tested_depths[j·S + s] gets the depth the test computed for each covered sample s (the
+/// others: unspecified). Returns how many samples are covered. The per-sample path's bits (as
+/// test_sample_row); needs AVX2.
 std::uint64_t test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&corner)[3], int n,
                                   const double* const (&offsets)[3], int S, DepthFunc func, bool depth_write,
-                                  float* depth, std::uint64_t* samples);
+                                  float* depth, std::uint64_t* samples, float* tested_depths = nullptr);
 
 /// The screen weights of pixels j < n of a row whose first pixel's sample has edge values e (bias
 /// not added), into l_i[j] (room for n rounded up to a multiple of 4): screen_weights' bits. False,
