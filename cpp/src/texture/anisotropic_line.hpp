@@ -15,6 +15,12 @@ namespace mipraster {
 /// not and log2_pmax is given, *log2_pmax is log2 Pmax (null: the log2 is skipped where it can be).
 bool anisotropic_magnifies(double pmax2, const Sampler& sampler, int levels, double* log2_pmax = nullptr);
 
+/// anisotropic_magnifies' first test: with no bias, no positive min_lod, a max_lod above 0 and
+/// more than one level (lod_is_plain), a squared length pmax2 > kSurelyMinifying2 has
+/// log2 Pmax > 7·10⁻⁶, past λ's snap to integers: λ > 0, it minifies.
+bool lod_is_plain(const Sampler& sampler, int levels);
+inline constexpr double kSurelyMinifying2 = 1.00001;
+
 /// The most probes a line of a sampler with this max_anisotropy takes (anisotropic_probe_count's cap).
 int most_probes(float max_anisotropy);
 

@@ -233,11 +233,13 @@ const std::array<double, kMostProbes + 1> kInverseCount = [] {
 
 }  // namespace
 
+bool lod_is_plain(const Sampler& s, int levels) {
+    return s.lod_bias == 0.0f && s.min_lod <= 0.0f && s.max_lod > 0.0f && levels > 1;
+}
+
 bool anisotropic_magnifies(double pmax2, const Sampler& s, int levels, double* log2_pmax) {
     if (plainly_magnifies(pmax2, s)) return true;
-    // Without bias or a positive min_lod, ρ² > 1 + 10⁻⁵ gives log2 ρ > 7·10⁻⁶, past the snap: λ > 0.
-    const bool plain = s.lod_bias == 0.0f && s.min_lod <= 0.0f && s.max_lod > 0.0f && levels > 1;
-    if (!log2_pmax && plain && pmax2 > 1.00001) return false;
+    if (!log2_pmax && lod_is_plain(s, levels) && pmax2 > kSurelyMinifying2) return false;
     const double log2_rho = log2_size(pmax2);
     if (log2_pmax) *log2_pmax = log2_rho;
     // Surely minifying (λ > 0 after snapping and clamping) without working λ out; else ask.

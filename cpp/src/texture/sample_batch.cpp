@@ -342,8 +342,7 @@ bool probe_lines(const LookupBatch& b, int n, int width, int height, int levels,
 #if defined(__x86_64__)
 // probe_lines with AVX2, four lanes per vector: per lane the same double operations (a division, a
 // square root and ⌈⌉ are exact-rounded in vectors too), so the same counts and factors. A lane
-// whose line the plain sampler's minification test (anisotropic_magnifies' first) cannot settle
-// asks anisotropic_magnifies. (One lane at a time, the division and the root were a tenth of a
+// whose line anisotropic_magnifies' first test (kSurelyMinifying2) cannot settle asks it. (One lane at a time, the division and the root were a tenth of a
 // 16× anisotropic frame.)
 [[gnu::target("avx2")]] bool probe_lines_avx2(const LookupBatch& b, int n, int width, int height, int levels,
                                               const Sampler& s, ProbeLines& lines) {
@@ -351,7 +350,7 @@ bool probe_lines(const LookupBatch& b, int n, int width, int height, int levels,
     const __m256d most = _mm256_set1_pd(max_n), most2 = _mm256_set1_pd(double(max_n) * max_n);
     const __m256d w = _mm256_set1_pd(width), h = _mm256_set1_pd(height);
     const __m256d infinity = _mm256_set1_pd(std::numeric_limits<double>::infinity());
-    const bool plain = s.lod_bias == 0.0f && s.min_lod <= 0.0f && s.max_lod > 0.0f && levels > 1;
+    const bool plain = lod_is_plain(s, levels);
     bool some = false;
     for (int l = 0; l < n; l += 4) {
         const __m128i used = _mm_cmpgt_epi32(_mm_set1_epi32(n - l), _mm_setr_epi32(0, 1, 2, 3));
@@ -369,7 +368,7 @@ bool probe_lines(const LookupBatch& b, int n, int width, int height, int levels,
         const __m256d finite = _mm256_and_pd(_mm256_cmp_pd(x, infinity, _CMP_LT_OQ),
                                              _mm256_cmp_pd(y, infinity, _CMP_LT_OQ));
         const __m256d lines_of_probes = _mm256_and_pd(finite, _mm256_cmp_pd(count, _mm256_set1_pd(1.0), _CMP_GT_OQ));
-        const __m256d minifies = _mm256_cmp_pd(pmax, _mm256_set1_pd(1.00001), _CMP_GT_OQ);
+        const __m256d minifies = _mm256_cmp_pd(pmax, _mm256_set1_pd(kSurelyMinifying2), _CMP_GT_OQ);
         alignas(32) double pmaxes[4];
         _mm256_store_pd(pmaxes, pmax);
         const int lanes_used = (1 << std::min(4, n - l)) - 1;
@@ -388,6 +387,11 @@ bool probe_lines(const LookupBatch& b, int n, int width, int height, int levels,
         some |= take != 0;
     }
     return some;
+}
+#else  // (other CPUs: the scalar lanes; never called)
+bool probe_lines_avx2(const LookupBatch& b, int n, int width, int height, int levels, const Sampler& s,
+                      ProbeLines& lines) {
+    return probe_lines(b, n, width, height, levels, s, lines);
 }
 #endif
 
@@ -507,13 +511,9 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     const int levels = texture_.level_count();
     ProbeLines lines;
     std::fill(lines.rho2_scale, lines.rho2_scale + kLookupBatch, 1.0f);
-#if defined(__x86_64__)
-    const auto lines_of = vector_width_ == 8 ? probe_lines_avx2 : probe_lines;
-#else
-    const auto lines_of = probe_lines;
-#endif
     const bool some_lines = s.footprint == FootprintFilter::anisotropic &&
-                            lines_of(b, n, texture_.width(), texture_.height(), levels, s, lines);
+                            (vector_width_ == 8 ? probe_lines_avx2 : probe_lines)(b, n, texture_.width(),
+                                                                                  texture_.height(), levels, s, lines);
     // A batch whose lanes all take lines (a surface at a grazing angle) reads no quad of the plan.
     bool only_lines = some_lines;
     for (int l = 0; l < n && only_lines; ++l) only_lines = lines.count[l] > 1;
