@@ -493,6 +493,70 @@ TEST(BatchSampler, EveryVectorWidthGivesTheSameBits) {
     EXPECT_GE(several_probes, 1000);  // (the eight-lane path's own line of probes: anisotropic_line_avx2)
 }
 
+// The eight-lane path decides each lane's line of probes four lanes per AVX2 vector
+// (probe_lines_avx2), the four-lane path one lane at a time: the same bits for caps that are not
+// integers or are huge, for ratios exactly on an integer (axis-aligned power-of-two footprints,
+// where ⌈√ratio²⌉ is decided exactly) or near the cap, and for samplers whose λ is not plain (a
+// bias, a min_lod, a max_lod of 0: the lanes that ask anisotropic_magnifies).
+TEST(BatchSampler, VectorLineDecisionsGiveTheScalarLanesBits) {
+    if (mr::BatchSampler::widest_vector() < 8) GTEST_SKIP() << "this CPU has no AVX2: only the four-lane path runs here";
+    const TextureCase tc{256, 128, 1.0f};
+    const mr::Texture tex = make_texture(tc, 4200);
+    mr::TextureView view(tex);
+    LookupGen gen(tc.w, tc.h, 4201);
+    long checked = 0, several_probes = 0, on_integers = 0, magnifying_asked = 0;
+    for (float cap : {1.5f, 2.5f, 7.9f, 16.0f, 1e4f}) {
+        for (int variant = 0; variant < 4; ++variant) {
+            mr::Sampler s;
+            s.footprint = mr::FootprintFilter::anisotropic;
+            s.max_anisotropy = cap;
+            if (variant == 1) s.lod_bias = 0.75f;
+            if (variant == 2) s.min_lod = 0.5f;
+            if (variant == 3) s.max_lod = 0.0f;
+            s.validate();
+            mr::BatchSampler four(view, s, 4), eight(view, s, 8);
+            for (int bi = 0; bi < 150; ++bi) {
+                mr::LookupBatch batch;
+                batch.count = gen.integer(1, mr::kLookupBatch);
+                std::vector<Lookup> lookups;
+                for (int lane = 0; lane < batch.count; ++lane) {
+                    Lookup l;
+                    l.uv = glm::vec2(float(gen.uniform(-2.0, 3.0)), float(gen.uniform(-2.0, 3.0)));
+                    const bool exact = gen.integer(0, 1);  // power-of-two lengths along the axes
+                    const double major = exact ? std::exp2(gen.integer(-2, 7)) : std::exp2(gen.uniform(-2.0, 7.0));
+                    const double ratio = exact ? std::exp2(gen.integer(0, 5))
+                                               : (gen.integer(0, 1) ? cap * (1.0 + gen.uniform(-1e-6, 1e-6))
+                                                                    : gen.uniform(1.0, 2.0 * cap));
+                    const double a = exact ? 0.0 : gen.uniform(0.0, 6.283185307179586);
+                    const glm::dvec2 along(std::cos(a), std::sin(a)), across(-along.y, along.x);
+                    const glm::dvec2 dx = along * major, dy = across * (major / ratio);
+                    l.dx = glm::vec2(float(dx.x / tc.w), float(dx.y / tc.h));
+                    l.dy = glm::vec2(float(dy.x / tc.w), float(dy.y / tc.h));
+                    if (gen.integer(0, 1)) std::swap(l.dx, l.dy);
+                    lookups.push_back(l);
+                    put(batch, lane, l);
+                    on_integers += exact && ratio > 1.0;
+                    magnifying_asked += variant != 0 && major <= 2.0 && ratio > 1.0;
+                }
+                glm::vec4 a[mr::kLookupBatch], b[mr::kLookupBatch];
+                four.sample(batch, a);
+                eight.sample(batch, b);
+                for (int lane = 0; lane < batch.count; ++lane, ++checked) {
+                    several_probes += surely_several_probes(view, s, lookups[lane]);
+                    ASSERT_TRUE(same_bits(a[lane], b[lane]))
+                        << str(s) << "\n  " << lookups[lane].describe() << "\n  four lanes " << str(a[lane])
+                        << ", eight lanes " << str(b[lane]);
+                }
+            }
+        }
+    }
+    std::cout << "lanes " << checked << ", several anisotropic probes " << several_probes << ", ratios on integers "
+              << on_integers << ", short lines of non-plain samplers " << magnifying_asked << "\n";
+    EXPECT_GE(several_probes, 10000);
+    EXPECT_GE(on_integers, 5000);
+    EXPECT_GE(magnifying_asked, 1000);
+}
+
 // A lane's value does not depend on the batch around it: the same lookup alone in lane 0 and in any
 // lane of a batch of random other lookups (unused lanes holding garbage) gives the same bits, and
 // out[i] for i ≥ count is left untouched.
