@@ -499,7 +499,8 @@ TEST(BatchSampler, EveryVectorWidthGivesTheSameBits) {
 // where ⌈√ratio²⌉ is decided exactly) or near the cap, and for samplers whose λ is not plain (a
 // bias, a min_lod, a max_lod of 0: the lanes that ask anisotropic_magnifies).
 TEST(BatchSampler, VectorLineDecisionsGiveTheScalarLanesBits) {
-    if (mr::BatchSampler::widest_vector() < 8) GTEST_SKIP() << "this CPU has no AVX2: only the four-lane path runs here";
+    if (mr::BatchSampler::widest_vector() < 8)
+        GTEST_SKIP() << "this CPU has no AVX2: only the four-lane path runs here";
     const TextureCase tc{256, 128, 1.0f};
     const mr::Texture tex = make_texture(tc, 4200);
     mr::TextureView view(tex);

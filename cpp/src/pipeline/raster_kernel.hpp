@@ -188,7 +188,8 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
         }
         sampler->sample(lookups, texel);
         for (int i = 0; i < n; ++i) {
-            const float* const depths = kMode == SampleMode::msaa && waiting[i].tested_depths ? waiting_depths[i] : nullptr;
+            const bool kept = kMode == SampleMode::msaa && waiting[i].tested_depths;
+            const float* const depths = kept ? waiting_depths[i] : nullptr;
             test_and_write(waiting[i].px, waiting[i].py, waiting[i].samples,
                            glm::dvec3(weights.l0[i], weights.l1[i], weights.l2[i]), colour[i] * texel[i], depths);
         }

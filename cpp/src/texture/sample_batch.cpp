@@ -342,8 +342,8 @@ bool probe_lines(const LookupBatch& b, int n, int width, int height, int levels,
 #if defined(__x86_64__)
 // probe_lines with AVX2, four lanes per vector: per lane the same double operations (a division, a
 // square root and ⌈⌉ are exact-rounded in vectors too), so the same counts and factors. A lane
-// whose line anisotropic_magnifies' first test (kSurelyMinifying2) cannot settle asks it. (One lane at a time, the division and the root were a tenth of a
-// 16× anisotropic frame.)
+// whose line anisotropic_magnifies' first test (kSurelyMinifying2) cannot settle asks it. (One
+// lane at a time, the division and the root were a tenth of a 16× anisotropic frame.)
 [[gnu::target("avx2")]] bool probe_lines_avx2(const LookupBatch& b, int n, int width, int height, int levels,
                                               const Sampler& s, ProbeLines& lines) {
     const int max_n = most_probes(s.max_anisotropy);
