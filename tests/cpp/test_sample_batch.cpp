@@ -440,6 +440,33 @@ TEST(BatchSampler, ConstantTexturesAreReturnedExactly) {
 // same bits for every lookup kind, sampler and size, lines of anisotropic probes included (the
 // reference's line against anisotropic_line_avx2). On a CPU without AVX2 the eight-lane path is
 // refused by name instead.
+/// `batches` batches of 1 … kLookupBatch lookups from next(), sampled at vector widths 4 and 8:
+/// the same bits lane by lane (a failure names the sampler and the lookup). Counts the lanes and
+/// those surely of several probes.
+template <typename Next>
+void expect_vector_widths_agree(const mr::TextureView& view, const mr::Sampler& s, LookupGen& gen, int batches,
+                                Next next, long& lanes, long& several_probes) {
+    mr::BatchSampler four(view, s, 4), eight(view, s, 8);
+    for (int bi = 0; bi < batches; ++bi) {
+        mr::LookupBatch batch;
+        batch.count = gen.integer(1, mr::kLookupBatch);
+        std::vector<Lookup> lookups;
+        for (int lane = 0; lane < batch.count; ++lane) {
+            lookups.push_back(next());
+            put(batch, lane, lookups.back());
+        }
+        glm::vec4 a[mr::kLookupBatch], b[mr::kLookupBatch];
+        four.sample(batch, a);
+        eight.sample(batch, b);
+        for (int lane = 0; lane < batch.count; ++lane, ++lanes) {
+            several_probes += surely_several_probes(view, s, lookups[lane]);
+            ASSERT_TRUE(same_bits(a[lane], b[lane]))
+                << view.width() << "x" << view.height() << " " << str(s) << "\n  " << lookups[lane].describe()
+                << "\n  four lanes " << str(a[lane]) << ", eight lanes " << str(b[lane]);
+        }
+    }
+}
+
 TEST(BatchSampler, EveryVectorWidthGivesTheSameBits) {
     EXPECT_THROW(mr::BatchSampler(mr::TextureView(make_texture(kTextures[0], 1)), mr::Sampler{}, 5), std::invalid_argument);
     {  // (and a batch count out of range is refused, not read past the arrays)
@@ -467,25 +494,8 @@ TEST(BatchSampler, EveryVectorWidthGivesTheSameBits) {
         LookupGen gen(tc.w, tc.h, 4100 + ti);
         for (int si = 0; si < 12; ++si) {
             const mr::Sampler s = covered_sampler(gen);
-            mr::BatchSampler four(view, s, 4), eight(view, s, 8);
-            for (int bi = 0; bi < 120; ++bi) {
-                mr::LookupBatch batch;
-                batch.count = gen.integer(1, mr::kLookupBatch);
-                std::vector<Lookup> lookups;
-                for (int lane = 0; lane < batch.count; ++lane) {
-                    lookups.push_back(gen.next());
-                    put(batch, lane, lookups.back());
-                }
-                glm::vec4 a[mr::kLookupBatch], b[mr::kLookupBatch];
-                four.sample(batch, a);
-                eight.sample(batch, b);
-                for (int lane = 0; lane < batch.count; ++lane, ++checked) {
-                    several_probes += surely_several_probes(view, s, lookups[lane]);
-                    ASSERT_TRUE(same_bits(a[lane], b[lane]))
-                        << tc.w << "x" << tc.h << " " << str(s) << "\n  " << lookups[lane].describe() << "\n  four lanes "
-                        << str(a[lane]) << ", eight lanes " << str(b[lane]);
-                }
-            }
+            expect_vector_widths_agree(view, s, gen, 120, [&] { return gen.next(); }, checked, several_probes);
+            if (HasFatalFailure()) return;
         }
     }
     std::cout << "lanes " << checked << ", several anisotropic probes " << several_probes << "\n";
@@ -515,40 +525,26 @@ TEST(BatchSampler, VectorLineDecisionsGiveTheScalarLanesBits) {
             if (variant == 2) s.min_lod = 0.5f;
             if (variant == 3) s.max_lod = 0.0f;
             s.validate();
-            mr::BatchSampler four(view, s, 4), eight(view, s, 8);
-            for (int bi = 0; bi < 150; ++bi) {
-                mr::LookupBatch batch;
-                batch.count = gen.integer(1, mr::kLookupBatch);
-                std::vector<Lookup> lookups;
-                for (int lane = 0; lane < batch.count; ++lane) {
-                    Lookup l;
-                    l.uv = glm::vec2(float(gen.uniform(-2.0, 3.0)), float(gen.uniform(-2.0, 3.0)));
-                    const bool exact = gen.integer(0, 1);  // power-of-two lengths along the axes
-                    const double major = exact ? std::exp2(gen.integer(-2, 7)) : std::exp2(gen.uniform(-2.0, 7.0));
-                    const double ratio = exact ? std::exp2(gen.integer(0, 5))
-                                               : (gen.integer(0, 1) ? cap * (1.0 + gen.uniform(-1e-6, 1e-6))
-                                                                    : gen.uniform(1.0, 2.0 * cap));
-                    const double a = exact ? 0.0 : gen.uniform(0.0, 6.283185307179586);
-                    const glm::dvec2 along(std::cos(a), std::sin(a)), across(-along.y, along.x);
-                    const glm::dvec2 dx = along * major, dy = across * (major / ratio);
-                    l.dx = glm::vec2(float(dx.x / tc.w), float(dx.y / tc.h));
-                    l.dy = glm::vec2(float(dy.x / tc.w), float(dy.y / tc.h));
-                    if (gen.integer(0, 1)) std::swap(l.dx, l.dy);
-                    lookups.push_back(l);
-                    put(batch, lane, l);
-                    on_integers += exact && ratio > 1.0;
-                    magnifying_asked += variant != 0 && major <= 2.0 && ratio > 1.0;
-                }
-                glm::vec4 a[mr::kLookupBatch], b[mr::kLookupBatch];
-                four.sample(batch, a);
-                eight.sample(batch, b);
-                for (int lane = 0; lane < batch.count; ++lane, ++checked) {
-                    several_probes += surely_several_probes(view, s, lookups[lane]);
-                    ASSERT_TRUE(same_bits(a[lane], b[lane]))
-                        << str(s) << "\n  " << lookups[lane].describe() << "\n  four lanes " << str(a[lane])
-                        << ", eight lanes " << str(b[lane]);
-                }
-            }
+            const auto next = [&] {
+                Lookup l;
+                l.uv = glm::vec2(float(gen.uniform(-2.0, 3.0)), float(gen.uniform(-2.0, 3.0)));
+                const bool exact = gen.integer(0, 1);  // power-of-two lengths along the axes
+                const double major = exact ? std::exp2(gen.integer(-2, 7)) : std::exp2(gen.uniform(-2.0, 7.0));
+                const double ratio = exact ? std::exp2(gen.integer(0, 5))
+                                           : (gen.integer(0, 1) ? cap * (1.0 + gen.uniform(-1e-6, 1e-6))
+                                                                : gen.uniform(1.0, 2.0 * cap));
+                const double a = exact ? 0.0 : gen.uniform(0.0, 6.283185307179586);
+                const glm::dvec2 along(std::cos(a), std::sin(a)), across(-along.y, along.x);
+                const glm::dvec2 dx = along * major, dy = across * (major / ratio);
+                l.dx = glm::vec2(float(dx.x / tc.w), float(dx.y / tc.h));
+                l.dy = glm::vec2(float(dy.x / tc.w), float(dy.y / tc.h));
+                if (gen.integer(0, 1)) std::swap(l.dx, l.dy);
+                on_integers += exact && ratio > 1.0;
+                magnifying_asked += variant != 0 && major <= 2.0 && ratio > 1.0;
+                return l;
+            };
+            expect_vector_widths_agree(view, s, gen, 150, next, checked, several_probes);
+            if (HasFatalFailure()) return;
         }
     }
     std::cout << "lanes " << checked << ", several anisotropic probes " << several_probes << ", ratios on integers "
