@@ -133,8 +133,8 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
 
     // Samples `samples` of pixel (px, py), shaded at screen weights l with colour c: discarded, or
     // counted as passed, their colour written and (depth_write) the depths their tests computed:
-    // from l where it is the sample's own (one sample shaded), else `depths` (sample s's at
-    // depths[s]) where the vector row test kept them, else from the sample's position.
+    // from l where it is the sample's own (one sample shaded), else (MSAA, depth-tested) as the
+    // tests kept them, sample s's at depths[s].
     const auto test_and_write = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l, glm::vec4 c,
                                     const float* depths) {
         if (!alpha_test(c, *draw.alpha_cutoff)) return;
@@ -148,26 +148,21 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
         counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples));  // (as GL counts them)
         if (kDepth != DepthFunc::none && draw.depth_write) {
             float* const depth_px = target.depth.at(px, py, 0);
-            std::int64_t p[3];
-            if (!depths) corner(px, py, p);
-            for (std::uint64_t m = samples; m; m &= m - 1) {
-                const int s = __builtin_ctzll(m);
-                depth_px[s] = depths ? depths[s] : sample_depth(t, weights_at(p, s));
-            }
+            for (std::uint64_t m = samples; m; m &= m - 1) depth_px[__builtin_ctzll(m)] = depths[__builtin_ctzll(m)];
         }
         float* const color_px = target.color.at(px, py, 0);
         for (std::uint64_t m = samples; m; m &= m - 1) blend_into<kBlend>(color_px + 4 * __builtin_ctzll(m), c);
     };
-    // The shades waiting for a batch (with `sampler`): pixel and samples (screen weights in `weights`,
-    // and where tested_depths, the samples' depths in waiting_depths).
+    // The shades waiting for a batch (with `sampler`): pixel and samples (screen weights in `weights`;
+    // MSAA with a depth test: the samples' tested depths in waiting_depths).
     struct Waiting {
         int px, py;
         std::uint64_t samples;
-        bool tested_depths;
     };
+    constexpr bool kKeepsDepths = kMode == SampleMode::msaa && kDepth != DepthFunc::none;
     BatchWeights weights;
     Waiting waiting[kLookupBatch];
-    float waiting_depths[kMode == SampleMode::msaa ? kLookupBatch : 1][kMaxSamples];
+    float waiting_depths[kKeepsDepths ? kLookupBatch : 1][kMaxSamples];
     LookupBatch lookups;
     const bool batched = sampler && interpolates_in_batches(draw, kShading, kTexturing, t);
     const Shading shading = batch_shading(kShading, colors);
@@ -187,16 +182,14 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
             lookups.count = n;
         }
         sampler->sample(lookups, texel);
-        for (int i = 0; i < n; ++i) {
-            const bool kept = kMode == SampleMode::msaa && waiting[i].tested_depths;
-            const float* const depths = kept ? waiting_depths[i] : nullptr;
+        for (int i = 0; i < n; ++i)
             test_and_write(waiting[i].px, waiting[i].py, waiting[i].samples,
-                           glm::dvec3(weights.l0[i], weights.l1[i], weights.l2[i]), colour[i] * texel[i], depths);
-        }
+                           glm::dvec3(weights.l0[i], weights.l1[i], weights.l2[i]), colour[i] * texel[i],
+                           kKeepsDepths ? waiting_depths[i] : nullptr);
         weights.count = 0;
     };
-    // Shades samples `samples` of pixel (px, py) at screen weights l (MSAA: their tested depths
-    // at depths[s], or null).
+    // Shades samples `samples` of pixel (px, py) at screen weights l (MSAA, depth-tested: their
+    // tested depths at depths[s]).
     const auto shade_samples = [&](int px, int py, std::uint64_t samples, const glm::dvec3& l,
                                    const float* depths = nullptr) {
         ++counters.shader_invocations;
@@ -207,14 +200,14 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
         }
         const int i = weights.count++;
         weights.l0[i] = l.x, weights.l1[i] = l.y, weights.l2[i] = l.z;
-        waiting[i] = {px, py, samples, depths != nullptr};
-        if (kMode == SampleMode::msaa && depths) std::memcpy(waiting_depths[i], depths, sizeof(float) * S);
+        waiting[i] = {px, py, samples};
+        if constexpr (kKeepsDepths) std::memcpy(waiting_depths[i], depths, sizeof(float) * S);
         if (weights.count == kLookupBatch) shade_waiting();
     };
-    // MSAA shades samples `passed` of pixel (px, py), whose corner has edge values p, once (their
-    // tested depths at depths[s], or null).
+    // MSAA shades samples `passed` of pixel (px, py), whose corner has edge values p, once (with a
+    // depth test: their tested depths at depths[s]).
     const auto shade_pixel = [&](int px, int py, std::uint64_t passed, const std::int64_t (&p)[3],
-                                 const float* depths = nullptr) {
+                                 const float* depths) {
         const std::int64_t c0 = p[0] + (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * (kStep / 2);
         const std::int64_t c1 = p[1] + (std::int64_t{t.edge_a[1]} + t.edge_b[1]) * (kStep / 2);
         const std::int64_t c2 = p[2] + (std::int64_t{t.edge_a[2]} + t.edge_b[2]) * (kStep / 2);
@@ -287,17 +280,18 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
             }
             counters.samples_covered += static_cast<std::uint64_t>(count_bits(covered));
             std::uint64_t passed = covered;
+            float tested[kMaxSamples];  // (MSAA writes the passing ones after the alpha test)
             if constexpr (kDepth != DepthFunc::none) {
                 const float* const stored = target.depth.at(px, py, 0);
                 for (std::uint64_t m = covered; m; m &= m - 1) {
                     const int s = __builtin_ctzll(m);
-                    if (!depth_passes<kDepth>(sample_depth(t, weights_at(p, s)), stored[s]))
-                        passed &= ~(std::uint64_t{1} << s);
+                    tested[s] = sample_depth(t, weights_at(p, s));
+                    if (!depth_passes<kDepth>(tested[s], stored[s])) passed &= ~(std::uint64_t{1} << s);
                 }
             }
             if (!passed) continue;
             if constexpr (kMode == SampleMode::msaa) {
-                shade_pixel(px, py, passed, p);
+                shade_pixel(px, py, passed, p, kDepth != DepthFunc::none ? tested : nullptr);
             } else {
                 for (std::uint64_t m = passed; m; m &= m - 1) {
                     const int s = __builtin_ctzll(m);
