@@ -161,6 +161,25 @@ void setup_range(const ChunkRange& range, const ClipSpaceGeometry& vertices, con
                  Keep&& keep) {
     SetupTriangle st;
     ClipPolygon polygon;
+    // Triangles inside the clip volume wait in fours for setup_four_triangles where the CPU has it;
+    // a clipped one lets those waiting through first, so that the order stays.
+    const bool fours = setup_in_fours();
+    const ScreenVertex* waiting[4][3];
+    std::uint32_t waiting_triangle[4];
+    int waiting_count = 0;
+    const auto set_up_waiting = [&] {
+        if (!waiting_count) return;
+        SetupTriangle four[4];
+        const int set_up = setup_four_triangles(waiting, waiting_count, viewport, vertices.cull, four, counters);
+        for (int i = 0; i < waiting_count; ++i) {
+            if (!(set_up >> i & 1)) continue;
+            four[i].triangle = waiting_triangle[i];
+            four[i].draw = range.draw;
+            four[i].clip_index = -1;
+            keep(four[i]);
+        }
+        waiting_count = 0;
+    };
     for (std::uint32_t t = range.first; t < range.last; ++t) {
         const glm::uvec3 tri = (*vertices.triangles)[t];
         const std::array<std::uint8_t, 3> codes = {vertices.outcodes[tri[0]], vertices.outcodes[tri[1]],
@@ -169,6 +188,16 @@ void setup_range(const ChunkRange& range, const ClipSpaceGeometry& vertices, con
             ++counters.dropped_nonfinite;
             continue;
         }
+        if ((codes[0] | codes[1] | codes[2]) == 0 && fours) {
+            for (int k = 0; k < 3; ++k) waiting[waiting_count][k] = &vertices.screen[tri[k]];
+            waiting_triangle[waiting_count] = t;
+            if (waiting_count == 0)  // (the lanes not used read the first triangle's vertices)
+                for (int i = 1; i < 4; ++i)
+                    for (int k = 0; k < 3; ++k) waiting[i][k] = waiting[0][k];
+            if (++waiting_count == 4) set_up_waiting();
+            continue;
+        }
+        set_up_waiting();
         st.triangle = t;
         st.draw = range.draw;
         if ((codes[0] | codes[1] | codes[2]) == 0) {  // inside: its vertices are projected already
@@ -215,6 +244,7 @@ void setup_range(const ChunkRange& range, const ClipSpaceGeometry& vertices, con
             }
         }
     }
+    set_up_waiting();
 }
 
 // Clip, set up and bin one chunk: its runs in order (`streamed`: their records with streaming

@@ -1,0 +1,179 @@
+// setup_four_triangles against setup_triangle, triangle by triangle: the same outcome, the same
+// counts and, for each triangle set up, the same bits in every field (DESIGN.md §2.8: every SIMD
+// path gives the scalar path's bits). Random triangles from clip space through project_vertex,
+// and screen vertices made by hand for the cases the arithmetic has to get right: areas past 2⁵³
+// (int64 → double rounding), coordinates at ±kMaxFixedCoordinate, every culling reason, invalid
+// vertices, unsnapped triangles of no area (infinite or NaN depth shifts), signed zero depths and
+// 1/w spanning the double range.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "mipraster/pipeline/triangle_setup.hpp"
+
+namespace {
+
+namespace mr = mipraster;
+
+template <typename T>
+bool same_bits(const T& a, const T& b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+// Every field setup_triangle writes, bit for bit; empty when they agree.
+std::string field_difference(const mr::SetupTriangle& a, const mr::SetupTriangle& b) {
+    if (!same_bits(a.edge_a, b.edge_a)) return "edge_a";
+    if (!same_bits(a.edge_b, b.edge_b)) return "edge_b";
+    if (!same_bits(a.edge_c, b.edge_c)) return "edge_c";
+    if (!same_bits(a.bias, b.bias)) return "bias";
+    if (a.min_x != b.min_x || a.min_y != b.min_y || a.max_x != b.max_x || a.max_y != b.max_y) return "bounds";
+    if (!same_bits(a.inv_area2, b.inv_area2)) return "inv_area2";
+    if (!same_bits(a.z0, b.z0)) return "z0";
+    if (!same_bits(a.dz1, b.dz1)) return "dz1";
+    if (!same_bits(a.dz2, b.dz2)) return "dz2";
+    if (!same_bits(a.inv_w, b.inv_w)) return "inv_w";
+    return "";
+}
+
+struct Tally {
+    long groups = 0, triangles = 0, set_up = 0, culled = 0;
+    long huge = 0;  // set up with |area2| > 2^53: int64 → double rounds
+};
+
+// Sets up the triangles in groups of `count` both ways and compares them.
+void expect_fours_agree(const std::vector<std::array<mr::ScreenVertex, 3>>& triangles, const mr::Viewport& viewport,
+                        mr::CullMode cull, int count, Tally& tally) {
+    for (std::size_t first = 0; first < triangles.size(); first += static_cast<std::size_t>(count)) {
+        const int n = static_cast<int>(std::min<std::size_t>(count, triangles.size() - first));
+        const mr::ScreenVertex* v[4][3];
+        for (int i = 0; i < 4; ++i)
+            for (int k = 0; k < 3; ++k) v[i][k] = &triangles[first + static_cast<std::size_t>(i < n ? i : 0)][k];
+        mr::SetupTriangle four[4];
+        mr::SetupCounters four_counts;
+        const int mask = mr::setup_four_triangles(v, n, viewport, cull, four, four_counts);
+        mr::SetupCounters one_counts;
+        for (int i = 0; i < n; ++i) {
+            mr::SetupTriangle one;
+            const bool set_up = mr::setup_triangle(triangles[first + static_cast<std::size_t>(i)], viewport, cull, one,
+                                                   one_counts);
+            ASSERT_EQ(set_up, (mask >> i & 1) != 0) << "triangle " << first + static_cast<std::size_t>(i);
+            if (set_up) {
+                ASSERT_EQ(field_difference(four[i], one), "") << "triangle " << first + static_cast<std::size_t>(i);
+                ++tally.set_up;
+                if (one.inv_area2 < 0x1p-53) ++tally.huge;
+            } else {
+                ++tally.culled;
+            }
+        }
+        ASSERT_EQ(mask >> n, 0) << "lanes past the count";
+        ASSERT_EQ(four_counts.dropped_nonfinite, one_counts.dropped_nonfinite);
+        ASSERT_EQ(four_counts.culled_degenerate, one_counts.culled_degenerate);
+        ASSERT_EQ(four_counts.culled_backface, one_counts.culled_backface);
+        ASSERT_EQ(four_counts.culled_outside, one_counts.culled_outside);
+        ++tally.groups;
+        tally.triangles += n;
+    }
+}
+
+void expect_fours_agree_everywhere(const std::vector<std::array<mr::ScreenVertex, 3>>& triangles,
+                                   const mr::Viewport& viewport, Tally& tally) {
+    for (const mr::CullMode cull : {mr::CullMode::none, mr::CullMode::back, mr::CullMode::front})
+        for (int count = 1; count <= 4; ++count) expect_fours_agree(triangles, viewport, cull, count, tally);
+}
+
+TEST(TriangleSetupFours, RandomClipSpaceTrianglesGiveTheScalarBitsOutcomesAndCounts) {
+    if (!mr::setup_in_fours()) GTEST_SKIP() << "no AVX2 on this CPU: setup_four_triangles has no vector path here";
+    std::mt19937_64 rng(20261129);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), w_of(0.01, 50.0), log_scale(-12.0, 3.0);
+    Tally tally;
+    const mr::Viewport viewports[] = {{1920, 1080, mr::DepthConvention::opengl},
+                                      {1, 1, mr::DepthConvention::reverse_z},
+                                      {333, 7, mr::DepthConvention::reverse_z},
+                                      {mr::kMaxDimension, mr::kMaxDimension, mr::DepthConvention::opengl}};
+    for (const mr::Viewport& viewport : viewports) {
+        std::vector<std::array<mr::ScreenVertex, 3>> triangles;
+        for (int t = 0; t < 4000; ++t) {
+            // Small triangles around a random centre (a mesh's), big ones, and slivers.
+            const double size = std::pow(10.0, log_scale(rng));
+            const glm::dvec4 centre(unit(rng) * 1.3, unit(rng) * 1.3, unit(rng), w_of(rng));
+            std::array<mr::ScreenVertex, 3> v;
+            for (int k = 0; k < 3; ++k) {
+                glm::dvec4 p = centre;
+                p.x += unit(rng) * size * p.w, p.y += unit(rng) * size * p.w, p.z += unit(rng) * 0.01 * p.w;
+                if (t % 7 == 0) p.w *= std::pow(10.0, 3.0 * unit(rng));  // very different depths and 1/w
+                v[k] = mr::project_vertex(p, viewport);
+            }
+            if (t % 11 == 0) v[2] = v[1];  // degenerate
+            triangles.push_back(v);
+        }
+        expect_fours_agree_everywhere(triangles, viewport, tally);
+    }
+    // Most are set up; every reason to refuse one occurs.
+    EXPECT_GT(tally.set_up, tally.triangles / 5) << tally.set_up << " of " << tally.triangles;
+    EXPECT_GT(tally.culled, 1000);
+}
+
+// A screen vertex made by hand (x, y in 1/256 px).
+mr::ScreenVertex vertex(std::int32_t x, std::int32_t y, double depth, double inv_w, float snap_x = 0.0f,
+                        float snap_y = 0.0f) {
+    mr::ScreenVertex v{};
+    v.x = x, v.y = y, v.depth = depth, v.inv_w = inv_w, v.snap_x = snap_x, v.snap_y = snap_y;
+    return v;
+}
+
+TEST(TriangleSetupFours, ExtremeVerticesGiveTheScalarBitsOutcomesAndCounts) {
+    if (!mr::setup_in_fours()) GTEST_SKIP() << "no AVX2 on this CPU: setup_four_triangles has no vector path here";
+    const auto M = static_cast<std::int32_t>(mr::kMaxFixedCoordinate);
+    const mr::Viewport viewport{mr::kMaxDimension, mr::kMaxDimension, mr::DepthConvention::opengl};
+    std::mt19937_64 rng(7);
+    std::uniform_int_distribution<std::int32_t> coordinate(-M, M), near_edge(M - 4096, M);
+    std::uniform_real_distribution<float> snap(-0.5f, 0.5f);
+    std::uniform_real_distribution<double> depth(0.0, 1.0), exponent(-300.0, 300.0);
+    std::vector<std::array<mr::ScreenVertex, 3>> triangles;
+    for (int t = 0; t < 6000; ++t) {
+        std::array<mr::ScreenVertex, 3> v;
+        for (int k = 0; k < 3; ++k) {
+            std::int32_t x = coordinate(rng), y = coordinate(rng);
+            if (t % 3 == 0) {  // at the coordinate limits: areas up to 2^60, past 2^53
+                x = (k == 1 ? -1 : 1) * near_edge(rng);
+                y = (k == 2 ? -1 : 1) * near_edge(rng);
+            }
+            if (t % 5 == 0) x = x / 256 * 256, y = y / 256 * 256;  // on pixel corners
+            double inv_w = std::pow(10.0, exponent(rng) * (t % 4 == 0 ? 1.0 : 0.01));
+            if (t % 13 == 0 && k == 1) inv_w = 0.0;  // an invalid vertex
+            double z = depth(rng);
+            if (t % 9 == 0) z = (k == 0 ? -0.0 : 0.0);  // signed zeros: the depth range is ±0
+            const bool snapped_exactly = t % 6 == 0;
+            v[k] = vertex(x, y, z, inv_w, snapped_exactly ? 0.0f : snap(rng), snapped_exactly ? 0.0f : snap(rng));
+        }
+        if (t % 17 == 0) {  // collinear unsnapped positions (no area: infinite or NaN shifts), some area snapped
+            v[1] = vertex(v[0].x + 512, v[0].y + 512, 0.25, 1.0, 0.25f, 0.25f);
+            v[2] = vertex(v[0].x + 1024, v[0].y + 1024 + 1, 0.75, 1.0, 0.5f, 0.5f - 1.0f / 256.0f);
+            v[0].snap_x = v[0].snap_y = 0.0f;
+        }
+        if (t % 19 == 0)  // (nearly) collinear
+            v[2] = vertex(v[0].x / 2 + v[1].x / 2, v[0].y / 2 + v[1].y / 2, 0.5, 1.0);
+        triangles.push_back(v);
+    }
+    // Outside the viewport on every side, and bounds clamped to it.
+    for (const auto& [dx, dy] : std::vector<std::pair<int, int>>{{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+        const std::int32_t x0 = dx < 0 ? -5000 : dx > 0 ? 256 * (mr::kMaxDimension + 3) : 256;
+        const std::int32_t y0 = dy < 0 ? -5000 : dy > 0 ? 256 * (mr::kMaxDimension + 3) : 256;
+        const mr::ScreenVertex a = vertex(x0, y0, 0.5, 1.0), b = vertex(x0 + 1000, y0, 0.5, 1.0),
+                               c = vertex(x0, y0 + 1000, 0.5, 1.0);
+        triangles.push_back({a, b, c});
+        triangles.push_back({a, c, b});
+    }
+    Tally tally;
+    expect_fours_agree_everywhere(triangles, viewport, tally);
+    EXPECT_GT(tally.set_up, 1000);
+    EXPECT_GT(tally.huge, 1000);
+    EXPECT_GT(tally.culled, 1000);
+}
+
+}  // namespace
