@@ -50,9 +50,9 @@ void expect_fours_agree(const std::vector<std::array<mr::ScreenVertex, 3>>& tria
                         mr::CullMode cull, int count, Tally& tally) {
     for (std::size_t first = 0; first < triangles.size(); first += static_cast<std::size_t>(count)) {
         const int n = static_cast<int>(std::min<std::size_t>(count, triangles.size() - first));
-        const mr::ScreenVertex* v[4][3];
-        for (int i = 0; i < 4; ++i)
-            for (int k = 0; k < 3; ++k) v[i][k] = &triangles[first + static_cast<std::size_t>(i < n ? i : 0)][k];
+        const mr::ScreenVertex* v[4][3] = {};  // (past n: null, not read)
+        for (int i = 0; i < n; ++i)
+            for (int k = 0; k < 3; ++k) v[i][k] = &triangles[first + static_cast<std::size_t>(i)][k];
         mr::SetupTriangle four[4];
         mr::SetupCounters four_counts;
         const int mask = mr::setup_four_triangles(v, n, viewport, cull, four, four_counts);

@@ -191,9 +191,6 @@ void setup_range(const ChunkRange& range, const ClipSpaceGeometry& vertices, con
         if ((codes[0] | codes[1] | codes[2]) == 0 && fours) {
             for (int k = 0; k < 3; ++k) waiting[waiting_count][k] = &vertices.screen[tri[k]];
             waiting_triangle[waiting_count] = t;
-            if (waiting_count == 0)  // (the lanes not used read the first triangle's vertices)
-                for (int i = 1; i < 4; ++i)
-                    for (int k = 0; k < 3; ++k) waiting[i][k] = waiting[0][k];
             if (++waiting_count == 4) set_up_waiting();
             continue;
         }

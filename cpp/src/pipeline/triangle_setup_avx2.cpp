@@ -61,8 +61,9 @@ namespace {
     // The vertices' fields, vertex k of triangle i in element i.
     __m128i X[3], Y[3];
     __m256d inv_w[3], depth[3], snap_x[3], snap_y[3];
+    const auto lane = [&](int i) { return i < count ? i : 0; };  // (lanes past the count repeat the first)
     for (int k = 0; k < 3; ++k) {
-        const ScreenVertex &a = *v[0][k], &b = *v[1][k], &c = *v[2][k], &d = *v[3][k];
+        const ScreenVertex &a = *v[0][k], &b = *v[lane(1)][k], &c = *v[lane(2)][k], &d = *v[lane(3)][k];
         X[k] = _mm_setr_epi32(a.x, b.x, c.x, d.x);
         Y[k] = _mm_setr_epi32(a.y, b.y, c.y, d.y);
         inv_w[k] = _mm256_setr_pd(a.inv_w, b.inv_w, c.inv_w, d.inv_w);

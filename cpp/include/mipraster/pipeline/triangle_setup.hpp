@@ -94,8 +94,8 @@ bool setup_triangle(const std::array<ScreenVertex, 3>& v, const Viewport& viewpo
 /// setup_triangle for triangles i < count ≤ 4 at once, triangle i's vertices *v[i][0..2], with
 /// AVX2 (triangle_setup_avx2.cpp): for each, the same outcome, counts and, where it is set up,
 /// the same bits in out[i] (its triangle, draw and clip_index left as they are). Returns the
-/// set-up triangles' mask (bit i: triangle i). v[i] for i ≥ count is read, not used: any
-/// vertices. Only where setup_in_fours().
+/// set-up triangles' mask (bit i: triangle i). v[i] for i ≥ count is not read. Only where
+/// setup_in_fours().
 int setup_four_triangles(const ScreenVertex* const (&v)[4][3], int count, const Viewport& viewport, CullMode cull,
                          SetupTriangle (&out)[4], SetupCounters& counters);
 
