@@ -1,19 +1,24 @@
-// setup_four_triangles against setup_triangle, triangle by triangle: the same outcome, the same
-// counts and, for each triangle set up, the same bits in every field (DESIGN.md §2.8: every SIMD
-// path gives the scalar path's bits). Random triangles from clip space through project_vertex,
-// and screen vertices made by hand for the cases the arithmetic has to get right: areas past 2⁵³
-// (int64 → double rounding), coordinates at ±kMaxFixedCoordinate, every culling reason, invalid
-// vertices, unsnapped triangles of no area (infinite or NaN depth shifts), signed zero depths and
-// 1/w spanning the double range.
+// The vector paths of setup (triangle_setup_avx2.cpp) against the scalar functions (DESIGN.md
+// §2.8: every SIMD path gives the scalar path's bits). classify_and_project_four against outcode
+// and project_vertex: the same outcodes, and the same screen vertices, on vertices past every
+// plane, non-finite ones, 1/w not normal and ties of the 1/256 px rounding. setup_four_triangles
+// against setup_triangle, triangle by triangle: the same outcome, the same counts and, for each
+// triangle set up, the same bits in every field, on random triangles from clip space through
+// project_vertex, and screen vertices made by hand for the cases the arithmetic has to get right:
+// areas past 2⁵³ (int64 → double rounding), coordinates at ±kMaxFixedCoordinate, every culling
+// reason, invalid vertices, unsnapped triangles of no area (infinite or NaN depth shifts), signed
+// zero depths and 1/w spanning the double range.
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "mipraster/pipeline/clip.hpp"
 #include "mipraster/pipeline/triangle_setup.hpp"
 
 namespace {
@@ -116,6 +121,60 @@ TEST(TriangleSetupFours, RandomClipSpaceTrianglesGiveTheScalarBitsOutcomesAndCou
     // Most are set up; every reason to refuse one occurs.
     EXPECT_GT(tally.set_up, tally.triangles / 5) << tally.set_up << " of " << tally.triangles;
     EXPECT_GT(tally.culled, 1000);
+}
+
+TEST(TriangleSetupFours, ClassifyAndProjectFourGivesTheScalarOutcodesAndScreenVertices) {
+    if (!mr::setup_in_fours()) GTEST_SKIP() << "no AVX2 on this CPU: classify_and_project_four has no vector path here";
+    std::mt19937_64 rng(2911);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), exponent(-300.0, 300.0);
+    std::uniform_int_distribution<int> tie(-600, 600);
+    long inside = 0, projected = 0, refused = 0, nonfinite = 0;
+    for (const auto& [width, height] : std::vector<std::pair<int, int>>{{2, 2}, {1920, 1080}, {7, 333},
+                                                                       {mr::kMaxDimension, mr::kMaxDimension}})
+        for (const mr::DepthConvention convention : {mr::DepthConvention::opengl, mr::DepthConvention::reverse_z}) {
+            const mr::Viewport viewport{width, height, convention};
+            const mr::ClipVolume volume = mr::make_clip_volume(convention, width, height);
+            std::vector<glm::dvec4> p(8000);
+            for (std::size_t i = 0; i < p.size(); ++i) {
+                double w = std::pow(10.0, unit(rng) * 2.0);
+                if (i % 23 == 0) w = std::pow(10.0, exponent(rng));  // 1/w subnormal, huge or beyond
+                if (i % 29 == 0) w = -w;
+                if (i % 31 == 0) w = mr::kMinClipW;  // on the w plane
+                glm::dvec4 q(unit(rng) * 1.2 * w, unit(rng) * 1.2 * w, unit(rng) * w, w);
+                if (i % 5 == 0) q.z = convention == mr::DepthConvention::opengl ? -w : 0.0;  // on the near/far plane
+                if (i % 3 == 0) q.x *= std::pow(10.0, 7.0 * std::abs(unit(rng)));  // out to past the guard band
+                if (i % 4 == 0) q.y *= std::pow(10.0, 7.0 * std::abs(unit(rng)));
+                if (i % 7 == 0 && width == 2)  // on a half 1/256 px: nearbyint's ties go to even
+                    q = glm::dvec4((tie(rng) + 0.5) / 256.0, (tie(rng) + 0.5) / 256.0, 0.5, 1.0);
+                if (i % 41 == 0) q = glm::dvec4(0.0, 0.0, 0.0, i % 2 ? 1e308 : 4e307);  // 1/w not normal, or just
+                if (i % 37 == 0) q[static_cast<int>(i / 37 % 4)] = i % 2 ? std::nan("") : -INFINITY;
+                p[i] = q;
+            }
+            std::vector<std::uint8_t> codes(p.size(), 0xFF);
+            std::vector<mr::ScreenVertex> screen(p.size(), mr::ScreenVertex{});
+            for (std::size_t i = 0; i < p.size(); i += 4)
+                mr::classify_and_project_four(&p[i], volume, viewport, &codes[i], &screen[i]);
+            for (std::size_t i = 0; i < p.size(); ++i) {
+                const bool finite = std::isfinite(p[i].x) && std::isfinite(p[i].y) && std::isfinite(p[i].z) &&
+                                    std::isfinite(p[i].w);
+                const std::uint8_t expected = finite ? mr::outcode(p[i], volume) : mr::kNonFinite;
+                ASSERT_EQ(codes[i], expected) << "vertex " << i;
+                nonfinite += !finite;
+                if (expected != 0) {
+                    ASSERT_TRUE(same_bits(screen[i], mr::ScreenVertex{})) << "written outside the volume: " << i;
+                    continue;
+                }
+                ++inside;
+                const mr::ScreenVertex v = mr::project_vertex(p[i], viewport);
+                ASSERT_TRUE(same_bits(screen[i], v)) << "vertex " << i << " (" << p[i].x << ", " << p[i].y << ", "
+                                                     << p[i].z << ", " << p[i].w << ")";
+                (v.valid() ? projected : refused) += 1;
+            }
+        }
+    EXPECT_GT(inside, 10000);
+    EXPECT_GT(projected, 10000);
+    EXPECT_GT(refused, 20);  // inside the volume, but 1/w not normal
+    EXPECT_GT(nonfinite, 500);
 }
 
 // A screen vertex made by hand (x, y in 1/256 px).

@@ -50,15 +50,17 @@ struct ClipSpaceGeometry {
     const std::vector<glm::uvec3>* triangles = nullptr;
     CullMode cull = CullMode::none;
 };
-constexpr std::uint8_t kNonFinite = 0x80;
-static_assert(kClipPlaneCount < 8, "kNonFinite must not collide with a plane bit");
 
 // Outcodes of positions [lo, hi), and the screen positions of those inside the volume: a triangle
 // of three such vertices is set up without clipping, and each vertex is projected once instead of
-// once for each of its triangles.
+// once for each of its triangles. Four at a time where the CPU has classify_and_project_four.
 void classify_and_project(ClipSpaceGeometry& g, std::size_t lo, std::size_t hi, const ClipVolume& volume,
                           const Viewport& viewport) {
-    for (std::size_t i = lo; i < hi; ++i) {
+    std::size_t i = lo;
+    if (setup_in_fours())
+        for (; i + 4 <= hi; i += 4)
+            classify_and_project_four(&g.positions[i], volume, viewport, &g.outcodes[i], &g.screen[i]);
+    for (; i < hi; ++i) {
         const glm::dvec4& p = g.positions[i];
         const bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.w);
         g.outcodes[i] = finite ? outcode(p, volume) : kNonFinite;

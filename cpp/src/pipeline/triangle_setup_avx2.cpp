@@ -53,6 +53,12 @@ namespace {
     return _mm256_blendv_pd(x, y, _mm256_cmp_pd(y, x, _CMP_LT_OQ));
 }
 
+// All-ones where x is finite (std::isfinite).
+[[gnu::target("avx2")]] inline __m256d finite(__m256d x) {
+    return _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), x),
+                         _mm256_set1_pd(std::numeric_limits<double>::infinity()), _CMP_LT_OQ);
+}
+
 }  // namespace
 
 [[gnu::target("avx2")]] int setup_four_triangles(const ScreenVertex* const (&v)[4][3], int count,
@@ -203,6 +209,88 @@ namespace {
     return set_up;
 }
 
+[[gnu::target("avx2")]] void classify_and_project_four(const glm::dvec4* p, const ClipVolume& volume,
+                                                       const Viewport& viewport, std::uint8_t* outcodes,
+                                                       ScreenVertex* screen) {
+    // The four positions' x, y, z and w, vertex i in element i.
+    const __m256d r0 = _mm256_loadu_pd(&p[0].x), r1 = _mm256_loadu_pd(&p[1].x);
+    const __m256d r2 = _mm256_loadu_pd(&p[2].x), r3 = _mm256_loadu_pd(&p[3].x);
+    const __m256d xz01 = _mm256_unpacklo_pd(r0, r1), yw01 = _mm256_unpackhi_pd(r0, r1);
+    const __m256d xz23 = _mm256_unpacklo_pd(r2, r3), yw23 = _mm256_unpackhi_pd(r2, r3);
+    const __m256d X = _mm256_permute2f128_pd(xz01, xz23, 0x20), Z = _mm256_permute2f128_pd(xz01, xz23, 0x31);
+    const __m256d Y = _mm256_permute2f128_pd(yw01, yw23, 0x20), W = _mm256_permute2f128_pd(yw01, yw23, 0x31);
+
+    const __m256d sign_bit = _mm256_set1_pd(-0.0), infinity = _mm256_set1_pd(std::numeric_limits<double>::infinity());
+    const int all_finite =
+        _mm256_movemask_pd(_mm256_and_pd(_mm256_and_pd(finite(X), finite(Y)), _mm256_and_pd(finite(Z), finite(W))));
+    // ClipPlane::distance, outside where !(d ≥ 0).
+    int outside[kClipPlaneCount];
+    for (int k = 0; k < kClipPlaneCount; ++k) {
+        const ClipPlane& plane = volume.planes[k];
+        const __m256d d = _mm256_add_pd(
+            _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(plane.normal.x), X),
+                                                      _mm256_mul_pd(_mm256_set1_pd(plane.normal.y), Y)),
+                                        _mm256_mul_pd(_mm256_set1_pd(plane.normal.z), Z)),
+                          _mm256_mul_pd(_mm256_set1_pd(plane.normal.w), W)),
+            _mm256_set1_pd(plane.offset));
+        outside[k] = _mm256_movemask_pd(_mm256_cmp_pd(d, _mm256_setzero_pd(), _CMP_NGE_UQ));
+    }
+    int inside = 0;  // (bit i: vertex i's outcode is 0)
+    for (int i = 0; i < 4; ++i) {
+        std::uint8_t code = kNonFinite;
+        if (all_finite >> i & 1) {
+            code = 0;
+            for (int k = 0; k < kClipPlaneCount; ++k) code |= static_cast<std::uint8_t>((outside[k] >> i & 1) << k);
+        }
+        outcodes[i] = code;
+        inside |= (code == 0) << i;
+    }
+    if (!inside) return;
+
+    // project_vertex's operations, in its order.
+    const __m256d one = _mm256_set1_pd(1.0), subpixel = _mm256_set1_pd(static_cast<double>(kSubpixelOne));
+    const __m256d inv_w = _mm256_div_pd(one, W);
+    const __m256d x = _mm256_mul_pd(
+        _mm256_mul_pd(_mm256_add_pd(_mm256_mul_pd(X, inv_w), one), _mm256_set1_pd(0.5 * viewport.width)), subpixel);
+    const __m256d y = _mm256_mul_pd(
+        _mm256_mul_pd(_mm256_sub_pd(one, _mm256_mul_pd(Y, inv_w)), _mm256_set1_pd(0.5 * viewport.height)), subpixel);
+    // nearbyint: to nearest, ties to even (the default rounding mode).
+    const __m256d xs = _mm256_round_pd(x, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+    const __m256d ys = _mm256_round_pd(y, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+    const __m256d z = _mm256_mul_pd(Z, inv_w);
+    const __m256d depth = viewport.depth_convention == DepthConvention::opengl
+                              ? _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(0.5), z), _mm256_set1_pd(0.5))
+                              : z;
+    const __m256d limit = _mm256_set1_pd(static_cast<double>(kMaxFixedCoordinate));
+    const __m256d in_range = _mm256_and_pd(_mm256_cmp_pd(_mm256_andnot_pd(sign_bit, xs), limit, _CMP_LE_OQ),
+                                           _mm256_cmp_pd(_mm256_andnot_pd(sign_bit, ys), limit, _CMP_LE_OQ));
+    const __m256d normal_positive = _mm256_and_pd(  // inv_w > 0 and std::isnormal(inv_w)
+        _mm256_cmp_pd(inv_w, _mm256_set1_pd(std::numeric_limits<double>::min()), _CMP_GE_OQ),
+        _mm256_cmp_pd(inv_w, infinity, _CMP_LT_OQ));
+    const int valid = _mm256_movemask_pd(_mm256_and_pd(_mm256_and_pd(in_range, finite(depth)), normal_positive));
+    std::int32_t xi[4], yi[4];
+    float snap_x[4], snap_y[4];
+    double w[4], depths[4];
+    // (Integer conversions of the invalid elements too: out of range, they give INT_MIN, unused.)
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(xi), _mm256_cvttpd_epi32(xs));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(yi), _mm256_cvttpd_epi32(ys));
+    _mm_storeu_ps(snap_x, _mm256_cvtpd_ps(_mm256_sub_pd(xs, x)));
+    _mm_storeu_ps(snap_y, _mm256_cvtpd_ps(_mm256_sub_pd(ys, y)));
+    _mm256_storeu_pd(w, inv_w);
+    _mm256_storeu_pd(depths, depth);
+    for (int i = 0; i < 4; ++i) {
+        if (!(inside >> i & 1)) continue;
+        ScreenVertex v{};
+        v.depth = depths[i];
+        if (valid >> i & 1) {
+            v.x = xi[i], v.y = yi[i];
+            v.snap_x = snap_x[i], v.snap_y = snap_y[i];
+            v.inv_w = w[i];
+        }
+        screen[i] = v;
+    }
+}
+
 bool setup_in_fours() {
     static const bool avx2 = __builtin_cpu_supports("avx2");
     return avx2;
@@ -216,6 +304,16 @@ int setup_four_triangles(const ScreenVertex* const (&v)[4][3], int count, const 
     for (int i = 0; i < count; ++i)
         if (setup_triangle({*v[i][0], *v[i][1], *v[i][2]}, viewport, cull, out[i], counters)) set_up |= 1 << i;
     return set_up;
+}
+
+void classify_and_project_four(const glm::dvec4* p, const ClipVolume& volume, const Viewport& viewport,
+                               std::uint8_t* outcodes, ScreenVertex* screen) {
+    for (int i = 0; i < 4; ++i) {
+        const bool finite = std::isfinite(p[i].x) && std::isfinite(p[i].y) && std::isfinite(p[i].z) &&
+                            std::isfinite(p[i].w);
+        outcodes[i] = finite ? outcode(p[i], volume) : kNonFinite;
+        if (outcodes[i] == 0) screen[i] = project_vertex(p[i], viewport);
+    }
 }
 
 bool setup_in_fours() { return false; }

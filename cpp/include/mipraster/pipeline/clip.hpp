@@ -45,6 +45,11 @@ struct ClipPolygon {
 
 enum class ClipOutcome { inside, outside, clipped };
 
+/// The outcode of a vertex with a NaN or infinite coordinate (e.g. from a degenerate matrix):
+/// no plane's bit.
+inline constexpr std::uint8_t kNonFinite = 0x80;
+static_assert(kClipPlaneCount < 8, "kNonFinite must not collide with a plane bit");
+
 /// Bit i set ⇔ p is outside plane i. Computed once per vertex; a triangle is trivially inside
 /// when its vertices' outcodes OR to 0 and trivially outside when they AND to non-zero.
 inline std::uint8_t outcode(const glm::dvec4& p, const ClipVolume& volume) {

@@ -9,6 +9,7 @@
 #include <glm/vec4.hpp>
 
 #include "mipraster/core/constants.hpp"
+#include "mipraster/pipeline/clip.hpp"
 #include "mipraster/pipeline/draw.hpp"
 #include "mipraster/scene/camera.hpp"
 
@@ -99,7 +100,14 @@ bool setup_triangle(const std::array<ScreenVertex, 3>& v, const Viewport& viewpo
 int setup_four_triangles(const ScreenVertex* const (&v)[4][3], int count, const Viewport& viewport, CullMode cull,
                          SetupTriangle (&out)[4], SetupCounters& counters);
 
-/// Whether this CPU has setup_four_triangles (AVX2).
+/// For clip-space vertices p[0..3]: outcodes[i] = kNonFinite where a coordinate is NaN or
+/// infinite, else outcode(p[i], volume), and where that is 0, screen[i] = project_vertex(p[i])
+/// (else screen[i] is not written). With AVX2 (triangle_setup_avx2.cpp), the bits of the scalar
+/// functions. Only where setup_in_fours().
+void classify_and_project_four(const glm::dvec4* p, const ClipVolume& volume, const Viewport& viewport,
+                               std::uint8_t* outcodes, ScreenVertex* screen);
+
+/// Whether this CPU has setup_four_triangles and classify_and_project_four (AVX2).
 bool setup_in_fours();
 
 /// The same for clip-space vertices p[0..2], projected here.
