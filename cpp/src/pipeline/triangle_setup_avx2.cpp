@@ -1,7 +1,8 @@
 // setup_four_triangles: setup_triangle (triangle_setup.cpp) for four triangles at once, one per
-// vector element, with the same integer and double operations element by element. The scalar
-// setup took a fifth of a frame of a million small triangles, most of it the depth planes' double
-// arithmetic, one triangle's chain of operations after the other.
+// vector element, with the same integer and double operations element by element; and
+// classify_and_project_four: outcode and project_vertex for four vertices the same way. The
+// scalar setup took a fifth of a frame of a million small triangles, most of it the depth planes'
+// double arithmetic, one triangle's chain of operations after the other.
 //
 // Where AVX2 has no instruction for a scalar step, the step is built from exact pieces: int64
 // products from 32 × 32-bit multiplies (every factor fits 32 bits: coordinates within
