@@ -10,7 +10,7 @@
 // high·2³² + low, each exact, added with one rounding (the conversion's).
 #include <immintrin.h>
 
-#include <cstring>
+#include <cstdint>
 #include <limits>
 
 #include "mipraster/pipeline/triangle_setup.hpp"
@@ -21,7 +21,7 @@ namespace mipraster {
 
 namespace {
 
-// Element i of a double vector, and the like.
+// A vector's elements into an array.
 [[gnu::target("avx2")]] inline void store(double (&to)[4], __m256d x) { _mm256_storeu_pd(to, x); }
 [[gnu::target("avx2")]] inline void store(std::int64_t (&to)[4], __m256i x) {
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(to), x);
