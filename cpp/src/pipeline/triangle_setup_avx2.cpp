@@ -54,6 +54,9 @@ namespace {
     return _mm256_blendv_pd(x, y, _mm256_cmp_pd(y, x, _CMP_LT_OQ));
 }
 
+// The pixel of a 1/256 px coordinate (floor_to_pixel of triangle_setup.cpp, for int32).
+inline __m128i to_pixel(__m128i x) { return _mm_srai_epi32(x, kSubpixelBits); }
+
 // All-ones where x is finite (std::isfinite).
 [[gnu::target("avx2")]] inline __m256d finite(__m256d x) {
     return _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), x),
@@ -96,13 +99,12 @@ namespace {
     const int culled = cull == CullMode::back ? clockwise : cull == CullMode::front ? counter_clockwise : 0;
 
     // Step 3: bounds in pixels (⌊x / 256⌋: an arithmetic shift), inside the viewport.
-    const __m128i min_x = _mm_max_epi32(
-        _mm_srai_epi32(_mm_min_epi32(_mm_min_epi32(X[0], X[1]), X[2]), kSubpixelBits), _mm_setzero_si128());
-    const __m128i max_x = _mm_min_epi32(_mm_srai_epi32(_mm_max_epi32(_mm_max_epi32(X[0], X[1]), X[2]), kSubpixelBits),
+    const __m128i zero32 = _mm_setzero_si128();
+    const __m128i min_x = _mm_max_epi32(to_pixel(_mm_min_epi32(_mm_min_epi32(X[0], X[1]), X[2])), zero32);
+    const __m128i max_x = _mm_min_epi32(to_pixel(_mm_max_epi32(_mm_max_epi32(X[0], X[1]), X[2])),
                                         _mm_set1_epi32(viewport.width - 1));
-    const __m128i min_y = _mm_max_epi32(
-        _mm_srai_epi32(_mm_min_epi32(_mm_min_epi32(Y[0], Y[1]), Y[2]), kSubpixelBits), _mm_setzero_si128());
-    const __m128i max_y = _mm_min_epi32(_mm_srai_epi32(_mm_max_epi32(_mm_max_epi32(Y[0], Y[1]), Y[2]), kSubpixelBits),
+    const __m128i min_y = _mm_max_epi32(to_pixel(_mm_min_epi32(_mm_min_epi32(Y[0], Y[1]), Y[2])), zero32);
+    const __m128i max_y = _mm_min_epi32(to_pixel(_mm_max_epi32(_mm_max_epi32(Y[0], Y[1]), Y[2])),
                                         _mm_set1_epi32(viewport.height - 1));
     const int outside = _mm_movemask_ps(
         _mm_castsi128_ps(_mm_or_si128(_mm_cmpgt_epi32(min_x, max_x), _mm_cmpgt_epi32(min_y, max_y))));
@@ -130,7 +132,6 @@ namespace {
         const int j = (i + 1) % 3, k = (i + 2) % 3;
         const __m128i a = times_sign(_mm_sub_epi32(Y[j], Y[k])), b = times_sign(_mm_sub_epi32(X[k], X[j]));
         const __m256i c = _mm256_sub_epi64(zero64, _mm256_add_epi64(multiply(a, X[j]), multiply(b, Y[j])));
-        const __m128i zero32 = _mm_setzero_si128();
         const __m128i top_left = _mm_or_si128(
             _mm_cmpgt_epi32(a, zero32), _mm_and_si128(_mm_cmpeq_epi32(a, zero32), _mm_cmpgt_epi32(b, zero32)));
         const __m128i one_unless_top_left = _mm_andnot_si128(top_left, _mm_set1_epi32(1));
@@ -161,16 +162,13 @@ namespace {
         const __m256d gx = _mm256_mul_pd(_mm256_sub_pd(_mm256_mul_pd(dz1, ey2), _mm256_mul_pd(dz2, ey1)), inverse);
         const __m256d gy = _mm256_mul_pd(_mm256_sub_pd(_mm256_mul_pd(dz2, ex1), _mm256_mul_pd(dz1, ex2)), inverse);
         const __m256d range = _mm256_sub_pd(max_of(max_of(z[0], z[1]), z[2]), min_of(min_of(z[0], z[1]), z[2]));
-        const __m256d sign_bit = _mm256_set1_pd(-0.0);
-        const __m256d infinity = _mm256_set1_pd(std::numeric_limits<double>::infinity());
-        const __m256d low = _mm256_xor_pd(range, sign_bit);  // −range
+        const __m256d low = _mm256_xor_pd(range, _mm256_set1_pd(-0.0));  // −range
         for (int k = 0; k < 3; ++k) {
             const __m256d shift = _mm256_add_pd(_mm256_mul_pd(gx, snap_x[k]), _mm256_mul_pd(gy, snap_y[k]));
             // std::clamp(shift, −range, range): shift < −range ? −range : range < shift ? range : shift.
             const __m256d below_high = _mm256_blendv_pd(shift, range, _mm256_cmp_pd(range, shift, _CMP_LT_OQ));
             const __m256d clamped = _mm256_blendv_pd(below_high, low, _mm256_cmp_pd(shift, low, _CMP_LT_OQ));
-            const __m256d moves = _mm256_and_pd(_mm256_cmp_pd(shift, zero, _CMP_NEQ_UQ),
-                                                _mm256_cmp_pd(_mm256_andnot_pd(sign_bit, shift), infinity, _CMP_LT_OQ));
+            const __m256d moves = _mm256_and_pd(_mm256_cmp_pd(shift, zero, _CMP_NEQ_UQ), finite(shift));
             z[k] = _mm256_blendv_pd(z[k], _mm256_add_pd(z[k], clamped), moves);
         }
     }
@@ -221,7 +219,6 @@ namespace {
     const __m256d X = _mm256_permute2f128_pd(xz01, xz23, 0x20), Z = _mm256_permute2f128_pd(xz01, xz23, 0x31);
     const __m256d Y = _mm256_permute2f128_pd(yw01, yw23, 0x20), W = _mm256_permute2f128_pd(yw01, yw23, 0x31);
 
-    const __m256d sign_bit = _mm256_set1_pd(-0.0), infinity = _mm256_set1_pd(std::numeric_limits<double>::infinity());
     const int all_finite =
         _mm256_movemask_pd(_mm256_and_pd(_mm256_and_pd(finite(X), finite(Y)), _mm256_and_pd(finite(Z), finite(W))));
     // ClipPlane::distance, outside where !(d ≥ 0).
@@ -263,11 +260,12 @@ namespace {
                               ? _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(0.5), z), _mm256_set1_pd(0.5))
                               : z;
     const __m256d limit = _mm256_set1_pd(static_cast<double>(kMaxFixedCoordinate));
+    const __m256d sign_bit = _mm256_set1_pd(-0.0);
     const __m256d in_range = _mm256_and_pd(_mm256_cmp_pd(_mm256_andnot_pd(sign_bit, xs), limit, _CMP_LE_OQ),
                                            _mm256_cmp_pd(_mm256_andnot_pd(sign_bit, ys), limit, _CMP_LE_OQ));
     const __m256d normal_positive = _mm256_and_pd(  // inv_w > 0 and std::isnormal(inv_w)
         _mm256_cmp_pd(inv_w, _mm256_set1_pd(std::numeric_limits<double>::min()), _CMP_GE_OQ),
-        _mm256_cmp_pd(inv_w, infinity, _CMP_LT_OQ));
+        finite(inv_w));
     const int valid = _mm256_movemask_pd(_mm256_and_pd(_mm256_and_pd(in_range, finite(depth)), normal_positive));
     std::int32_t xi[4], yi[4];
     float snap_x[4], snap_y[4];
