@@ -210,10 +210,16 @@ TEST(TriangleSetupFours, ExtremeVerticesGiveTheScalarBitsOutcomesAndCounts) {
             const bool snapped_exactly = t % 6 == 0;
             v[k] = vertex(x, y, z, inv_w, snapped_exactly ? 0.0f : snap(rng), snapped_exactly ? 0.0f : snap(rng));
         }
-        if (t % 17 == 0) {  // collinear unsnapped positions (no area: infinite or NaN shifts), some area snapped
-            v[1] = vertex(v[0].x + 512, v[0].y + 512, 0.25, 1.0, 0.25f, 0.25f);
-            v[2] = vertex(v[0].x + 1024, v[0].y + 1024 + 1, 0.75, 1.0, 0.5f, 0.5f - 1.0f / 256.0f);
-            v[0].snap_x = v[0].snap_y = 0.0f;
+        if (t % 17 == 0) {  // unsnapped on a line (no area), snapped not: NaN or infinite depth shifts
+            const std::int32_t x = 25600 + t, y = 12800 - t;  // (offsets below in 1/256 px)
+            v[0] = vertex(x, y, 0.25, 1.0);
+            if (t % 34 == 0) {  // unsnapped (0, 0), (3, 1), (4.5, 1.5): the last snaps to (4, 2), shift +∞
+                v[1] = vertex(x + 3, y + 1, 0.5, 1.0);
+                v[2] = vertex(x + 4, y + 2, 0.75, 1.0, -0.5f, 0.5f);
+            } else {  // unsnapped (0, 0), (2, 1), (5, 2.5): the last snaps to (5, 2), shifts ∞ · 0 = NaN
+                v[1] = vertex(x + 2, y + 1, 0.5, 1.0);
+                v[2] = vertex(x + 5, y + 2, 0.75, 1.0, 0.0f, -0.5f);
+            }
         }
         if (t % 19 == 0)  // (nearly) collinear
             v[2] = vertex(v[0].x / 2 + v[1].x / 2, v[0].y / 2 + v[1].y / 2, 0.5, 1.0);
