@@ -397,6 +397,56 @@ TEST(DeferredShading, BinningAddsOverlapAreasOnlyWhenAsked) {
     }
 }
 
+// The binner's shortcut for a triangle whose bounds lie in one tile gives tile_overlap_area's sum
+// too: small triangles on the tiles' borders (touching, not crossing them) and on the viewport's
+// edges, where the bounds are clamped, and slivers that cut a corner of the viewport from outside
+// (their clamped bounds reach into the corner tile, they cover none of it: the estimate is 0).
+TEST(DeferredShading, BinningSumsOverlapAreasOfSmallTrianglesOnTileAndViewportEdges) {
+    std::mt19937_64 rng(47);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (const int N : {200, 700}) {  // the last row and column of tiles partial, 8 and 28 pixels
+        SCOPED_TRACE(std::to_string(N) + "×" + std::to_string(N));
+        const mr::TileGrid grid = mr::TileGrid::for_viewport(N, N);
+        const int tiles = grid.tiles_x;
+        // Where to put a vertex: near a tile border or the viewport's edge, or anywhere.
+        const auto coordinate = [&](int pick) {
+            const double edge = pick == 0 ? mr::kTileSize * static_cast<int>(tiles * unit(rng)) : pick == 1 ? N : 0.0;
+            return pick == 3 ? N * unit(rng) : edge + 8.0 * (unit(rng) - 0.5);
+        };
+        mr::BinnedChunk chunk;
+        int missed = 0;  // triangles listed in a tile they cover none of
+        for (int k = 0; k < 6000; ++k) {
+            std::array<glm::dvec2, 3> v;
+            if (k % 10 == 9) {  // past corner c: its edge AB crosses the diagonal outside, 0.3 px from c
+                const glm::dvec2 c(unit(rng) < 0.5 ? 0.0 : N, unit(rng) < 0.5 ? 0.0 : N);
+                const glm::dvec2 out(c.x == 0.0 ? -1.0 : 1.0, c.y == 0.0 ? -1.0 : 1.0);
+                const double r = 1.0 + 3.0 * unit(rng);
+                v = {c + out * glm::dvec2(r + 0.3, -r), c + out * glm::dvec2(-r, r + 0.3), c + out * r};
+            } else {
+                const glm::dvec2 c(coordinate(static_cast<int>(4 * unit(rng))), coordinate(static_cast<int>(4 * unit(rng))));
+                const double size = 0.5 + 6.0 * unit(rng);
+                for (glm::dvec2& vertex : v) vertex = c + size * glm::dvec2(unit(rng) - 0.5, unit(rng) - 0.5);
+            }
+            mr::SetupTriangle t;
+            if (set_up(v, N, t)) chunk.triangles.push_back(t);
+        }
+        mr::bin_triangles(chunk, grid, true);
+        for (int tile = 0; tile < grid.count(); ++tile) {
+            const int x0 = tile % tiles * mr::kTileSize, y0 = tile / tiles * mr::kTileSize;
+            double sum = 0.0;
+            for (std::uint32_t i = chunk.tile_start[tile]; i < chunk.tile_start[tile + 1]; ++i) {
+                const double area = mr::tile_overlap_area(chunk.triangles[chunk.tile_triangles[i]], x0, y0,
+                                                          std::min(x0 + mr::kTileSize, N), std::min(y0 + mr::kTileSize, N));
+                missed += area == 0.0;
+                sum += area;
+            }
+            EXPECT_EQ(chunk.tile_area[static_cast<std::size_t>(tile)], sum) << "tile " << tile;
+        }
+        EXPECT_GT(chunk.triangles.size(), 3500u);
+        EXPECT_GT(missed, 50);
+    }
+}
+
 // Binning lists each tile's triangles as a brute-force scan finds them: every triangle whose pixel
 // bounds touch the tile, in ascending order.
 TEST(DeferredShading, BinningListsEveryTileItsTouchingTrianglesInOrder) {

@@ -99,6 +99,19 @@ void ChunkBinner::add(const SetupTriangle& t) {
     const auto tile_of = [](int pixel) { return static_cast<std::uint16_t>(pixel / kTileSize); };
     const TileSpan span{tile_of(t.min_x), tile_of(t.min_y), tile_of(t.max_x), tile_of(t.max_y)};
     spans_.push_back(span);
+    if (span.x0 == span.x1 && span.y0 == span.y1) {  // most small triangles: one tile
+        const std::size_t tile = static_cast<std::size_t>(span.y0) * grid_.tiles_x + span.x0;
+        ++chunk_.tile_start[tile + 1];
+        if (!overlap_areas_) return;
+        // A box off the viewport's edges was not clamped to it, so it holds the vertices: t lies
+        // in the tile and covers some of it, not all (tile_overlap_area's last case, inline).
+        const bool unclamped = t.min_x > 0 && t.min_y > 0 && t.max_x + 1 < grid_.width && t.max_y + 1 < grid_.height;
+        const int x0 = span.x0 * kTileSize, y0 = span.y0 * kTileSize;
+        chunk_.tile_area[tile] += unclamped ? box_share(t, t.min_x, t.min_y, t.max_x + 1, t.max_y + 1)
+                                            : tile_overlap_area(t, x0, y0, std::min(x0 + kTileSize, grid_.width),
+                                                                std::min(y0 + kTileSize, grid_.height));
+        return;
+    }
     for (int ty = span.y0; ty <= span.y1; ++ty)
         for (int tx = span.x0; tx <= span.x1; ++tx) {
             const std::size_t tile = static_cast<std::size_t>(ty) * grid_.tiles_x + tx;
@@ -106,10 +119,7 @@ void ChunkBinner::add(const SetupTriangle& t) {
             if (!overlap_areas_) continue;
             const int x0 = tx * kTileSize, y0 = ty * kTileSize;
             const int x1 = std::min(x0 + kTileSize, grid_.width), y1 = std::min(y0 + kTileSize, grid_.height);
-            // (Most small triangles lie inside one tile: tile_overlap_area's first case, inline.)
-            chunk_.tile_area[tile] += box_inside(t, x0, y0, x1, y1)
-                                          ? box_share(t, t.min_x, t.min_y, t.max_x + 1, t.max_y + 1)
-                                          : tile_overlap_area(t, x0, y0, x1, y1);
+            chunk_.tile_area[tile] += tile_overlap_area(t, x0, y0, x1, y1);
         }
 }
 
