@@ -447,6 +447,48 @@ TEST(DeferredShading, BinningSumsOverlapAreasOfSmallTrianglesOnTileAndViewportEd
     }
 }
 
+// With enough_overdraw, a tile's sum is the exact one wherever that stays below enough_overdraw
+// times the tile's area, and reaches that much wherever the exact one does: the same answer to
+// "is the overdraw at least enough_overdraw?", with less summed (large triangles, piled up).
+TEST(DeferredShading, BinningStopsSummingATileAtEnoughOverdrawWithTheSameAnswer) {
+    std::mt19937_64 rng(48);
+    for (const int N : {200, 700}) {
+        SCOPED_TRACE(std::to_string(N) + "×" + std::to_string(N));
+        const mr::TileGrid grid = mr::TileGrid::for_viewport(N, N);
+        mr::BinnedChunk exact, enough;
+        for (int k = 0; k < 60; ++k) {
+            const double size = std::array<double, 4>{3.0, 40.0, 0.5 * N, 1.5 * N}[k % 4];
+            mr::SetupTriangle t;
+            if (set_up(random_screen_triangle(rng, size, N), N, t)) {
+                exact.triangles.push_back(t);
+                enough.triangles.push_back(t);
+            }
+        }
+        const double kEnough = 1.25;
+        mr::bin_triangles(exact, grid, true);
+        mr::bin_triangles(enough, grid, true, kEnough);
+        EXPECT_EQ(exact.tile_start, enough.tile_start);
+        int below = 0, stopped = 0;
+        for (int tile = 0; tile < grid.count(); ++tile) {
+            const int x0 = tile % grid.tiles_x * mr::kTileSize, y0 = tile / grid.tiles_x * mr::kTileSize;
+            const double limit = kEnough * std::min(mr::kTileSize, N - x0) * std::min(mr::kTileSize, N - y0);
+            const double all = exact.tile_area[static_cast<std::size_t>(tile)];
+            const double some = enough.tile_area[static_cast<std::size_t>(tile)];
+            if (all < limit) {
+                ++below;
+                EXPECT_EQ(some, all) << "tile " << tile;
+            } else {
+                EXPECT_GE(some, limit) << "tile " << tile;
+                EXPECT_LE(some, all) << "tile " << tile;
+                stopped += some < all;
+            }
+        }
+        std::cout << "tiles below " << below << ", stopped " << stopped << " of " << grid.count() << "\n";
+        EXPECT_GT(below, grid.count() / 20);
+        EXPECT_GT(stopped, grid.count() / 4);
+    }
+}
+
 // Binning lists each tile's triangles as a brute-force scan finds them: every triangle whose pixel
 // bounds touch the tile, in ascending order.
 TEST(DeferredShading, BinningListsEveryTileItsTouchingTrianglesInOrder) {

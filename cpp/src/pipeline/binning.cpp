@@ -88,8 +88,8 @@ double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1)
 
 static_assert((kMaxDimension + kTileSize - 1) / kTileSize <= 65536, "tile coordinates must fit 16 bits");
 
-ChunkBinner::ChunkBinner(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas)
-    : chunk_(chunk), grid_(grid), overlap_areas_(overlap_areas) {
+ChunkBinner::ChunkBinner(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas, double enough_overdraw)
+    : chunk_(chunk), grid_(grid), overlap_areas_(overlap_areas), enough_overdraw_(enough_overdraw) {
     chunk.tile_start.assign(static_cast<std::size_t>(grid.count()) + 1, 0);
     chunk.tile_area.assign(overlap_areas ? static_cast<std::size_t>(grid.count()) : 0, 0.0);
     reserve_on_huge_pages(spans_, chunk.triangles.capacity());
@@ -119,7 +119,8 @@ void ChunkBinner::add(const SetupTriangle& t) {
             if (!overlap_areas_) continue;
             const int x0 = tx * kTileSize, y0 = ty * kTileSize;
             const int x1 = std::min(x0 + kTileSize, grid_.width), y1 = std::min(y0 + kTileSize, grid_.height);
-            chunk_.tile_area[tile] += tile_overlap_area(t, x0, y0, x1, y1);
+            double& sum = chunk_.tile_area[tile];
+            if (sum < enough_overdraw_ * (double(x1 - x0) * double(y1 - y0))) sum += tile_overlap_area(t, x0, y0, x1, y1);
         }
 }
 
@@ -137,8 +138,8 @@ void ChunkBinner::finish() {
     }
 }
 
-void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas) {
-    ChunkBinner binner(chunk, grid, overlap_areas);
+void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas, double enough_overdraw) {
+    ChunkBinner binner(chunk, grid, overlap_areas, enough_overdraw);
     for (const SetupTriangle& t : chunk.triangles) binner.add(t);
     binner.finish();
 }

@@ -247,14 +247,19 @@ void setup_range(const ChunkRange& range, const ClipSpaceGeometry& vertices, con
 }
 
 // Clip, set up and bin one chunk: its runs in order (`streamed`: their records with streaming
-// stores).
+// stores; enough_overdraw: setup_and_bin's).
 void setup_chunk(const std::vector<ChunkRange>& runs, const std::vector<ClipSpaceGeometry>& geometry,
-                 const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid, bool overlap_areas,
-                 bool streamed, BinnedChunk& chunk, SetupCounters& counters, std::uint64_t& clipped) {
+                 const ClipVolume& volume, const Viewport& viewport, const TileGrid& grid,
+                 const std::vector<double>& enough_overdraw, bool streamed, BinnedChunk& chunk,
+                 SetupCounters& counters, std::uint64_t& clipped) {
     std::size_t count = 0;
-    for (const ChunkRange& run : runs) count += run.last - run.first;
+    double enough = 0.0;  // (the largest of its draws')
+    for (const ChunkRange& run : runs) {
+        count += run.last - run.first;
+        if (!enough_overdraw.empty()) enough = std::max(enough, enough_overdraw[run.draw]);
+    }
     reserve_on_huge_pages(chunk.triangles, count);
-    ChunkBinner binner(chunk, grid, overlap_areas);
+    ChunkBinner binner(chunk, grid, !enough_overdraw.empty(), enough);
     const auto keep = [&](const SetupTriangle& t) {
         binner.add(t);
         if (streamed) append_streamed(chunk.triangles, t);
@@ -270,11 +275,13 @@ void setup_chunk(const std::vector<ChunkRange>& runs, const std::vector<ClipSpac
 }
 
 // Stage 2: clip, set up and bin every draw's triangles, in parallel over chunks of consecutive
-// triangles (with each tile's overlap estimate when `overlap_areas`); adds the triangle counts to
-// `stats`.
+// triangles; adds the triangle counts to `stats`. With each tile's overlap estimate unless
+// `enough_overdraw` is empty: per draw, the overdraw from which a tile's estimate says all that
+// is asked of it (ChunkBinner), +∞ for the exact sum.
 std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geometry, const ClipVolume& volume,
-                                       const Viewport& viewport, const TileGrid& grid, bool overlap_areas,
-                                       ThreadPool& pool, RenderStats& stats) {
+                                       const Viewport& viewport, const TileGrid& grid,
+                                       const std::vector<double>& enough_overdraw, ThreadPool& pool,
+                                       RenderStats& stats) {
     // Each draw in runs of `size` triangles, a chunk each; the runs of small draws gather into
     // chunks of up to kMinChunkTriangles (each chunk has a table per tile, and each tile looks at
     // every chunk: ten thousand two-triangle draws took 13× the time of one draw of them all).
@@ -304,7 +311,7 @@ std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geo
     pool.parallel_for(chunk_runs.size(), [&](std::size_t i) {
         SetupCounters counters;  // (stored once: neighbouring chunks' counters share cache lines)
         std::uint64_t clipped_here = 0;
-        setup_chunk(chunk_runs[i], geometry, volume, viewport, grid, overlap_areas, streamed, chunks[i], counters,
+        setup_chunk(chunk_runs[i], geometry, volume, viewport, grid, enough_overdraw, streamed, chunks[i], counters,
                     clipped_here);
         setup_counters[i] = counters;
         clipped[i] = clipped_here;
@@ -616,10 +623,14 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     const bool every_draw_deferrable = std::find(deferrable.begin(), deferrable.end(), 0) == deferrable.end();
 
     // Stage 2: clip, set up and bin (with the per-tile overlap estimate only where a tile may be
-    // deferred).
+    // deferred; defer_tile asks no more of a tile with a textured draw than kDeferredMinOverdraw).
     t0 = Clock::now();
     const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
-    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, deferred, pool, stats);
+    std::vector<double> enough_overdraw;
+    if (deferred)
+        for (const DrawInputs& input : inputs)
+            enough_overdraw.push_back(input.texture ? kDeferredMinOverdraw : std::numeric_limits<double>::infinity());
+    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, enough_overdraw, pool, stats);
     stats.setup_ms = ms_since(t0);
 
     // Stage 3: per tile, one task each: clear, rasterize (shade, depth test, blend) the tile's
@@ -803,7 +814,7 @@ Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::v
     // Stage 2: clip, set up and bin.
     t0 = Clock::now();
     const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
-    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, false, pool, stats);
+    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, {}, pool, stats);
     stats.setup_ms = ms_since(t0);
 
     // Stage 3: every tile records the nearest triangle of each sample.

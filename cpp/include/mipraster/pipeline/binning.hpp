@@ -1,6 +1,7 @@
 #pragma once
 // Binning stage: set-up triangles sorted into screen tiles, keeping submission order per tile.
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "mipraster/core/block_recycler.hpp"
@@ -45,10 +46,14 @@ double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1)
 /// triangle's tiles (and, when `overlap_areas`, adds up chunk.tile_area) from the set-up record
 /// at hand, finish() places them in chunk.tile_start / tile_triangles from each triangle's tile
 /// range, kept in 8 bytes. No pass reads the triangles back: a million of them are 128 MB, and
-/// reading them from memory twice was a sixth of a frame.
+/// reading them from memory twice was a sixth of a frame. Triangles larger than a tile add nothing
+/// more to a tile's sum once it reaches `enough_overdraw` times the tile's area: where no more is
+/// asked of it (a textured tile is deferred from kDeferredMinOverdraw on), summing their clipped
+/// areas would be work for nothing (a fifth of a frame of 1,000 large triangles overlapping).
 class ChunkBinner {
 public:
-    ChunkBinner(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas);
+    ChunkBinner(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas,
+                double enough_overdraw = std::numeric_limits<double>::infinity());
     /// Counts t, the triangle that becomes chunk.triangles[n] for the n-th call.
     void add(const SetupTriangle& t);
     /// Fills chunk.tile_start and chunk.tile_triangles (after the last add()).
@@ -61,10 +66,12 @@ private:
     BinnedChunk& chunk_;
     const TileGrid& grid_;
     bool overlap_areas_;
+    double enough_overdraw_;
     RecycledVector<TileSpan> spans_;
 };
 
 /// All of chunk.triangles at once: ChunkBinner's add() for each, then finish().
-void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas);
+void bin_triangles(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas,
+                   double enough_overdraw = std::numeric_limits<double>::infinity());
 
 }  // namespace mipraster
