@@ -423,7 +423,8 @@ TEST(DeferredShading, BinningSumsOverlapAreasOfSmallTrianglesOnTileAndViewportEd
                 const double r = 1.0 + 3.0 * unit(rng);
                 v = {c + out * glm::dvec2(r + 0.3, -r), c + out * glm::dvec2(-r, r + 0.3), c + out * r};
             } else {
-                const glm::dvec2 c(coordinate(static_cast<int>(4 * unit(rng))), coordinate(static_cast<int>(4 * unit(rng))));
+                const int pick_x = static_cast<int>(4 * unit(rng)), pick_y = static_cast<int>(4 * unit(rng));
+                const glm::dvec2 c(coordinate(pick_x), coordinate(pick_y));
                 const double size = 0.5 + 6.0 * unit(rng);
                 for (glm::dvec2& vertex : v) vertex = c + size * glm::dvec2(unit(rng) - 0.5, unit(rng) - 0.5);
             }
@@ -436,7 +437,8 @@ TEST(DeferredShading, BinningSumsOverlapAreasOfSmallTrianglesOnTileAndViewportEd
             double sum = 0.0;
             for (std::uint32_t i = chunk.tile_start[tile]; i < chunk.tile_start[tile + 1]; ++i) {
                 const double area = mr::tile_overlap_area(chunk.triangles[chunk.tile_triangles[i]], x0, y0,
-                                                          std::min(x0 + mr::kTileSize, N), std::min(y0 + mr::kTileSize, N));
+                                                          std::min(x0 + mr::kTileSize, N),
+                                                          std::min(y0 + mr::kTileSize, N));
                 missed += area == 0.0;
                 sum += area;
             }

@@ -120,7 +120,8 @@ void ChunkBinner::add(const SetupTriangle& t) {
             const int x0 = tx * kTileSize, y0 = ty * kTileSize;
             const int x1 = std::min(x0 + kTileSize, grid_.width), y1 = std::min(y0 + kTileSize, grid_.height);
             double& sum = chunk_.tile_area[tile];
-            if (sum < enough_overdraw_ * (double(x1 - x0) * double(y1 - y0))) sum += tile_overlap_area(t, x0, y0, x1, y1);
+            const double enough = enough_overdraw_ * (double(x1 - x0) * double(y1 - y0));
+            if (sum < enough) sum += tile_overlap_area(t, x0, y0, x1, y1);
         }
 }
 

@@ -630,7 +630,8 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     if (deferred)
         for (const DrawInputs& input : inputs)
             enough_overdraw.push_back(input.texture ? kDeferredMinOverdraw : std::numeric_limits<double>::infinity());
-    const std::vector<BinnedChunk> chunks = setup_and_bin(geometry, volume, viewport, grid, enough_overdraw, pool, stats);
+    const std::vector<BinnedChunk> chunks =
+        setup_and_bin(geometry, volume, viewport, grid, enough_overdraw, pool, stats);
     stats.setup_ms = ms_since(t0);
 
     // Stage 3: per tile, one task each: clear, rasterize (shade, depth test, blend) the tile's
