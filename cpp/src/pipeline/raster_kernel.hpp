@@ -353,12 +353,15 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         // Most small triangles classify no block: they skip the per-pixel block test.
         const std::uint32_t classified = cls.skipped | cls.hidden;
 
-        // The vertex colours of the original triangle, once per triangle and tile.
-        VertexValues colors{};  // (constant shading: unused, zeros)
-        if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective) {
-            const glm::uvec3 tri = draw.triangles[t.triangle];
-            colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
-        }
+        // The vertex colours of the original triangle, once per triangle and tile (constant shading:
+        // unused, zeros).
+        const VertexValues colors = [&] {
+            if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective) {
+                const glm::uvec3 tri = draw.triangles[t.triangle];
+                return VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
+            }
+            return VertexValues{};
+        }();
         TriangleUvs uvs;
         if constexpr (kTexturing != Texturing::none) {
             uvs = TriangleUvs(t, draw.triangles[t.triangle], draw.uvs, batch.clip_weights);
@@ -403,9 +406,12 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 offset0[s] = static_cast<double>(off0[s]), offset1[s] = static_cast<double>(off1[s]),
                 offset2[s] = static_cast<double>(off2[s]);
 
-        // A sample s of pixel (px, py) at screen weights l that passed the depth test (stored).
-        const auto passed_sample = [&](int px, int py, int s, const glm::dvec3& l) {
-            if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
+        // A sample s of pixel (px, py) at screen weights l that passed the depth test (stored; the
+        // caller tells `blocks`). color_px: the pixel's colour slots (colour_slots).
+        const auto colour_slots = [&](int px, int py) {
+            return kShading == Shading::visibility ? nullptr : color_out.at(px, py, 0);
+        };
+        const auto passed_sample = [&](float* color_px, int px, int py, int s, const glm::dvec3& l) {
             ++counters.samples_passed;
             if constexpr (kShading == Shading::visibility) {
                 if (target.owners) {
@@ -419,9 +425,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 target.barycentrics.data[2 * i + 1] = static_cast<float>(w.z);
             } else {
                 ++counters.shader_invocations;
-                shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_out.at(px, py, s),
-                                                         std::uint64_t{1}, draw, colors, uvs, t, l, batch.clip_weights,
-                                                         px, py);
+                shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px + 4 * s, std::uint64_t{1},
+                                                         draw, colors, uvs, t, l, batch.clip_weights, px, py);
             }
         };
 
@@ -519,9 +524,11 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         counters.samples_covered += static_cast<std::uint64_t>(count_bits(row.covered & ~skipped));
                         if constexpr (kShading == Shading::visibility || kTexturing != Texturing::none || kColours)
                             if (passed_row(rx0, py, s, row)) continue;
+                        blocks.written_row(py, rx0, row.passed);
                         for (std::uint32_t m = row.passed; m; m &= m - 1) {
                             const int j = __builtin_ctz(m);
-                            passed_sample(rx0 + j, py, s, glm::dvec3(row.l0[j], row.l1[j], row.l2[j]));
+                            passed_sample(colour_slots(rx0 + j, py), rx0 + j, py, s,
+                                          glm::dvec3(row.l0[j], row.l1[j], row.l2[j]));
                         }
                     }
                     if (rows) continue;
@@ -630,6 +637,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                                                              t, l, batch.clip_weights, px, py);
                 } else {
                     // Shade every covered sample that passes the depth test.
+                    float* const color_px = colour_slots(px, py);
+                    bool written = false;
                     for (; covered; covered &= covered - 1) {
                         const int s = __builtin_ctzll(covered);
                         ++counters.samples_covered;
@@ -643,9 +652,11 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                             const float z = sample_depth(t, l);
                             if (!depth_passes<kDepth>(z, depth_px[s])) continue;
                             if (draw.depth_write) depth_px[s] = z;
+                            written = true;
                         }
-                        passed_sample(px, py, s, l);
+                        passed_sample(color_px, px, py, s, l);
                     }
+                    if (written) blocks.written(px, py);
                 }
             }
         }

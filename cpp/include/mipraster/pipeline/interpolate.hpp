@@ -58,11 +58,13 @@ inline glm::dvec3 original_weights(const SetupTriangle& t, const glm::dvec3& w, 
 struct VertexValues {
     glm::vec4 v[3];
     glm::vec4 lo, hi;
+    glm::dvec4 wide[3];  ///< v in double, once per triangle, not per sample interpolated
 
     VertexValues() = default;
     /// lo = glm::min(a, glm::min(b, c)) and hi = glm::max(a, glm::max(b, c)), four components at
     /// once: glm's min(x, y) is y < x ? y : x and max(x, y) is x < y ? y : x, selected the same way.
-    VertexValues(const glm::vec4& a, const glm::vec4& b, const glm::vec4& c) : v{a, b, c} {
+    VertexValues(const glm::vec4& a, const glm::vec4& b, const glm::vec4& c)
+        : v{a, b, c}, wide{glm::dvec4(a), glm::dvec4(b), glm::dvec4(c)} {
         typedef float Four __attribute__((vector_size(16)));
         Four x, y, z;
         std::memcpy(&x, &a, sizeof x);
@@ -79,14 +81,13 @@ struct VertexValues {
     glm::vec4 interpolate(const glm::dvec3& w) const {
         typedef float Four __attribute__((vector_size(16)));
         typedef double FourDoubles __attribute__((vector_size(32)));
-        Four a, b, c, low, high;
-        std::memcpy(&a, &v[0], sizeof a);
-        std::memcpy(&b, &v[1], sizeof b);
-        std::memcpy(&c, &v[2], sizeof c);
+        Four low, high;
+        FourDoubles a2, b2, c2;
+        std::memcpy(&a2, &wide[0], sizeof a2);
+        std::memcpy(&b2, &wide[1], sizeof b2);
+        std::memcpy(&c2, &wide[2], sizeof c2);
         std::memcpy(&low, &lo, sizeof low);
         std::memcpy(&high, &hi, sizeof high);
-        const FourDoubles a2 = __builtin_convertvector(a, FourDoubles), b2 = __builtin_convertvector(b, FourDoubles),
-                          c2 = __builtin_convertvector(c, FourDoubles);
         const FourDoubles sum = w.x * a2 + w.y * b2 + w.z * c2;
         const Four x = __builtin_convertvector(sum, Four);
         const Four clamped = x < low ? low : (high < x ? high : x);
