@@ -355,8 +355,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
 
         // The vertex colours of the original triangle, once per triangle and tile (constant shading:
         // unused, zeros).
+        constexpr bool kVertexColours =
+            kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective;
         const VertexValues colors = [&] {
-            if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective) {
+            if constexpr (kVertexColours) {
                 const glm::uvec3 tri = draw.triangles[t.triangle];
                 return VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
             }
