@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "helpers.hpp"
+#include "pipeline/tile_blocks.hpp"
 
 namespace {
 
@@ -24,6 +25,51 @@ using namespace helpers;
 /// order, with premultiplied vertex colours.
 mr::Mesh random_overlap(std::size_t n, double size, std::uint64_t seed) {
     return random_triangles(n, size, seed, {-1.5, -1.0, -2.0}, {3.0, 2.0, 8.0}, 0.5);
+}
+
+// A row's pixels in given blocks, and a row trimmed of skipped blocks at its ends, against the
+// blocks pixel by pixel: tile targets of every size and one-row spans starting anywhere in a tile
+// (whose first block is partial), random block sets and random runs of each row.
+TEST(BlockSkipping, RowMasksAndTrimsFollowTheBlocksPixelByPixel) {
+    std::mt19937_64 rng(49);
+    const mr::SamplePattern pattern = mr::make_sample_pattern(mr::PatternKind::center, 1);
+    const auto random_int = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    for (int round = 0; round < 4000; ++round) {
+        mr::TileTarget target{};
+        target.pattern = &pattern;
+        const int tile_x = mr::kTileSize * random_int(0, 5), tile_y = mr::kTileSize * random_int(0, 5);
+        if (round % 2 == 0) {  // a tile, maybe partial
+            target.x0 = tile_x, target.y0 = tile_y;
+            target.x1 = tile_x + random_int(1, mr::kTileSize), target.y1 = tile_y + random_int(1, mr::kTileSize);
+        } else {  // a span of one row
+            target.x0 = tile_x + random_int(0, mr::kTileSize - 1), target.x1 = random_int(target.x0 + 1, tile_x + mr::kTileSize);
+            target.y0 = tile_y + random_int(0, mr::kTileSize - 1), target.y1 = target.y0 + 1;
+        }
+        const mr::kernels::TileBlocks blocks(target, 1);
+        const auto block_of = [&](int x, int y) {  // bit of the block holding pixel (x, y)
+            return ((y >> 3) - (target.y0 >> 3)) * (mr::kTileSize / 8) + (x >> 3) - (target.x0 >> 3);
+        };
+        const auto bits = static_cast<std::uint32_t>(rng());
+        for (int y = target.y0; y < target.y1; ++y) {
+            const int x0 = random_int(target.x0, target.x1 - 1), x1 = random_int(x0 + 1, target.x1);
+            std::uint32_t expected = 0;
+            int first = x1, last = x0 - 1;  // pixels of [x0, x1) outside the blocks of `bits`
+            for (int x = x0; x < x1; ++x) {
+                const bool in = bits >> block_of(x, y) & 1;
+                expected |= static_cast<std::uint32_t>(in) << (x - x0);
+                if (!in) first = std::min(first, x), last = std::max(last, x);
+            }
+            ASSERT_EQ(blocks.row_pixels(bits, y, x0, x1 - x0), expected) << "row " << y << " from " << x0;
+            int trimmed0 = x0, trimmed1 = x1;
+            blocks.trim(bits, y, trimmed0, trimmed1);
+            if (first > last) {
+                EXPECT_GE(trimmed0, trimmed1) << "row " << y << " from " << x0 << " to " << x1;
+            } else {
+                EXPECT_EQ(trimmed0, first) << "row " << y << " from " << x0 << " to " << x1;
+                EXPECT_EQ(trimmed1, last + 1) << "row " << y << " from " << x0 << " to " << x1;
+            }
+        }
+    }
 }
 
 TEST(BlockSkipping, SameBitsAndCountersAsThePlainPathOnRandomOverlappingScenes) {

@@ -127,20 +127,23 @@ public:
 
     /// Bit j set where pixel (x0 + j, y) lies in a block of `bits` (j < n ≤ 32).
     std::uint32_t row_pixels(std::uint32_t bits, int y, int x0, int n) const {
-        std::uint32_t out = 0;
-        for (int x = x0; bits && x < x0 + n;) {
-            const int end = std::min(x0 + n, ((x >> kBlockShift) + 1) << kBlockShift);
-            if (bits >> bit(x, y) & 1) out |= ((std::uint32_t{1} << (end - x)) - 1) << (x - x0);
-            x = end;
-        }
-        return out;
+        const std::uint64_t columns = block_columns(bits, y) >> (x0 - (bx0_ << kBlockShift));
+        return static_cast<std::uint32_t>(columns & ((std::uint64_t{1} << n) - 1));
     }
 
-    /// Narrows the pixels [x0, x1) of row y to leave out skipped blocks at either end.
+    /// Narrows the pixels [x0, x1) of row y to leave out skipped blocks at either end (x0 ≥ x1
+    /// when all of them are).
     void trim(std::uint32_t skipped, int y, int& x0, int& x1) const {
-        if (!skipped) return;
-        while (x0 < x1 && (skipped >> bit(x0, y) & 1)) x0 = ((x0 >> kBlockShift) + 1) << kBlockShift;
-        while (x0 < x1 && (skipped >> bit(x1 - 1, y) & 1)) x1 = ((x1 - 1) >> kBlockShift) << kBlockShift;
+        if (!skipped || x0 >= x1) return;
+        const int first = bx0_ << kBlockShift;  // column 0 of block_columns
+        const std::uint64_t range = (std::uint64_t{1} << (x1 - first)) - (std::uint64_t{1} << (x0 - first));
+        const std::uint64_t kept = range & ~std::uint64_t{block_columns(skipped, y)};
+        if (!kept) {
+            x0 = x1;
+            return;
+        }
+        x0 = first + __builtin_ctzll(kept);
+        x1 = first + 64 - __builtin_clzll(kept);
     }
 
     /// Classifies the blocks of t's bounding box [x0, x1) × [y0, y1) (clipped to the target) with
@@ -155,6 +158,15 @@ public:
     }
 
 private:
+    // The pixels of the blocks of `bits` on pixel row y's row of blocks: bit c for the column
+    // (bx0_ << kBlockShift) + c, each block's bit spread over its kBlock columns (a multiply
+    // moves bit b to bit 8b; the four partial products do not overlap, so nothing carries).
+    std::uint32_t block_columns(std::uint32_t bits, int y) const {
+        static_assert(kBlock == 8 && kBlocksPerSide == 4, "the spread is for a row of four blocks of eight");
+        const std::uint32_t row = bits >> (((y >> kBlockShift) - by0_) * kBlocksPerSide) & 0xfu;
+        return ((row * 0x204081u) & 0x01010101u) * 0xffu;
+    }
+
     template <DepthFunc kDepth>
     [[gnu::noinline]] BlockClasses classify_blocks(const SetupTriangle& t, int x0, int y0, int x1, int y1, int S,
                                                    bool whole) {
