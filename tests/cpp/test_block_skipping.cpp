@@ -42,7 +42,8 @@ TEST(BlockSkipping, RowMasksAndTrimsFollowTheBlocksPixelByPixel) {
             target.x0 = tile_x, target.y0 = tile_y;
             target.x1 = tile_x + random_int(1, mr::kTileSize), target.y1 = tile_y + random_int(1, mr::kTileSize);
         } else {  // a span of one row
-            target.x0 = tile_x + random_int(0, mr::kTileSize - 1), target.x1 = random_int(target.x0 + 1, tile_x + mr::kTileSize);
+            target.x0 = tile_x + random_int(0, mr::kTileSize - 1);
+            target.x1 = random_int(target.x0 + 1, tile_x + mr::kTileSize);
             target.y0 = tile_y + random_int(0, mr::kTileSize - 1), target.y1 = target.y0 + 1;
         }
         const mr::kernels::TileBlocks blocks(target, 1);
