@@ -46,10 +46,10 @@ double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1)
 /// triangle's tiles (and, when `overlap_areas`, adds up chunk.tile_area) from the set-up record
 /// at hand, finish() places them in chunk.tile_start / tile_triangles from each triangle's tile
 /// range, kept in 8 bytes. No pass reads the triangles back: a million of them are 128 MB, and
-/// reading them from memory twice was a sixth of a frame. Triangles larger than a tile add nothing
-/// more to a tile's sum once it reaches `enough_overdraw` times the tile's area: where no more is
-/// asked of it (a textured tile is deferred from kDeferredMinOverdraw on), summing their clipped
-/// areas would be work for nothing (a fifth of a frame of 1,000 large triangles overlapping).
+/// reading them from memory twice was a sixth of a frame. Triangles whose bounds reach past one tile
+/// add nothing more to a tile's sum once it reaches `enough_overdraw` times the tile's area: where
+/// no more is asked of it (a textured tile is deferred from kDeferredMinOverdraw on), summing their
+/// clipped areas would be work for nothing (a tenth of a frame of 1,000 large overlapping triangles).
 class ChunkBinner {
 public:
     ChunkBinner(BinnedChunk& chunk, const TileGrid& grid, bool overlap_areas,
