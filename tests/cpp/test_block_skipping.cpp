@@ -5,14 +5,18 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "helpers.hpp"
+#include "mipraster/pipeline/interpolate.hpp"
+#include "mipraster/pipeline/triangle_setup.hpp"
 #include "pipeline/tile_blocks.hpp"
 
 namespace {
@@ -71,6 +75,194 @@ TEST(BlockSkipping, RowMasksAndTrimsFollowTheBlocksPixelByPixel) {
             }
         }
     }
+}
+
+// The bits of the blocks holding pixels of a rectangle, against the blocks pixel by pixel.
+TEST(BlockSkipping, BlocksInARectangleAreTheBlocksOfItsPixels) {
+    std::mt19937_64 rng(50);
+    const mr::SamplePattern pattern = mr::make_sample_pattern(mr::PatternKind::center, 1);
+    const auto random_int = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    for (int round = 0; round < 4000; ++round) {
+        mr::TileTarget target{};
+        target.pattern = &pattern;
+        target.x0 = mr::kTileSize * random_int(0, 5), target.y0 = mr::kTileSize * random_int(0, 5);
+        target.x1 = target.x0 + random_int(1, mr::kTileSize), target.y1 = target.y0 + random_int(1, mr::kTileSize);
+        const mr::kernels::TileBlocks blocks(target, 1);
+        const int x0 = random_int(target.x0, target.x1 - 1), x1 = random_int(x0 + 1, target.x1);
+        const int y0 = random_int(target.y0, target.y1 - 1), y1 = random_int(y0 + 1, target.y1);
+        std::uint32_t expected = 0;
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) expected |= std::uint32_t{1} << blocks.bit(x, y);
+        ASSERT_EQ(blocks.blocks_in(x0, y0, x1, y1), expected) << x0 << "…" << x1 << " × " << y0 << "…" << y1;
+    }
+}
+
+// What TileBlocks::classify says of each block, against the blocks one by one: block_coverage and
+// nearest_depth over the block's samples (whole tiles: first over the tile's, all blocks at once), the
+// stored depths scanned; and against every sample: no covered sample in a block found to have none, no
+// uncovered one where all are, none that would pass in a block rejected by depth. Triangles from a
+// pixel to far beyond the tile, tilted in depth, one after another on a depth buffer that moves nearer
+// in random blocks between them (the bounds TileBlocks keeps from earlier triangles must follow), 1
+// and 4 samples, partial tiles.
+TEST(BlockSkipping, ClassesAreEachBlocksCoverageAndDepthBound) {
+    namespace k = mr::kernels;
+    std::mt19937_64 rng(51);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const int N = 80;  // tiles of 32, 32 and 16 pixels a side
+    int rejected = 0, hidden = 0, whole_skipped = 0, compared = 0;
+    for (int S : {1, 4}) {
+        const mr::SamplePattern pattern =
+            mr::make_sample_pattern(S == 1 ? mr::PatternKind::center : mr::PatternKind::rotated, S);
+        std::vector<float> depth(static_cast<std::size_t>(N) * N * S);
+        for (int round = 0; round < 400; ++round) {
+            mr::TileTarget target{};
+            target.pattern = &pattern;
+            target.depth = mr::SampleWindow{depth.data(), 1, 0, 0, N, S};
+            target.x0 = mr::kTileSize * static_cast<int>(3 * unit(rng));
+            target.y0 = mr::kTileSize * static_cast<int>(3 * unit(rng));
+            target.x1 = std::min(N, target.x0 + mr::kTileSize), target.y1 = std::min(N, target.y0 + mr::kTileSize);
+            for (float& d : depth) d = static_cast<float>(0.2 + 0.6 * unit(rng));  // (reverse-Z: greater wins)
+            k::TileBlocks blocks(target, S);
+            for (int step = 0; step < 40; ++step) {
+                const double size = std::array<double, 4>{3.0, 20.0, 120.0, 2000.0}[step % 4];
+                std::array<glm::dvec4, 3> p;
+                const glm::dvec2 c(N * unit(rng), N * unit(rng));
+                for (glm::dvec4& v : p) {
+                    const glm::dvec2 s = c + size * glm::dvec2(unit(rng) - 0.5, unit(rng) - 0.5);
+                    v = glm::dvec4(2.0 * s.x / N - 1.0, 1.0 - 2.0 * s.y / N, 0.1 + 0.8 * unit(rng), 1.0);
+                }
+                mr::Viewport vp;
+                vp.width = vp.height = N;
+                mr::SetupTriangle t;
+                mr::SetupCounters counters;
+                if (!mr::setup_triangle(p, vp, mr::CullMode::none, t, counters)) continue;
+                const int x0 = std::max(t.min_x, target.x0), x1 = std::min(t.max_x + 1, target.x1);
+                const int y0 = std::max(t.min_y, target.y0), y1 = std::min(t.max_y + 1, target.y1);
+                if (x0 >= x1 || y0 >= y1) continue;
+                const k::BlockClasses got = blocks.classify<mr::DepthFunc::greater>(t, x0, y0, x1, y1, S);
+
+                // Per block: samples covered, all covered, the farthest stored depth, the bound.
+                const auto edges = [&](int x, int y, int s, std::int64_t (&e)[3]) {
+                    const std::int64_t X = x * mr::kSubpixelOne + pattern.x[s], Y = y * mr::kSubpixelOne + pattern.y[s];
+                    for (int i = 0; i < 3; ++i) e[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+                };
+                const auto extent = [&](int bx0, int by0, int bx1, int by1) {
+                    const auto [ox0, ox1] = std::minmax_element(pattern.x.begin(), pattern.x.begin() + S);
+                    const auto [oy0, oy1] = std::minmax_element(pattern.y.begin(), pattern.y.begin() + S);
+                    return k::SampleExtent{bx0 * mr::kSubpixelOne + *ox0, by0 * mr::kSubpixelOne + *oy0,
+                                           (bx1 - 1) * mr::kSubpixelOne + *ox1, (by1 - 1) * mr::kSubpixelOne + *oy1};
+                };
+                struct Block {
+                    int x0, y0, x1, y1;
+                    long covered = 0, samples = 0;
+                    float farthest = std::numeric_limits<float>::infinity();
+                    bool loses = true;  // every covered sample fails the depth test
+                };
+                std::vector<Block> in_box;
+                std::uint32_t box_bits = 0;
+                for (int by = target.y0; by < target.y1; by += k::kBlock)
+                    for (int bx = target.x0; bx < target.x1; bx += k::kBlock) {
+                        Block b{std::max(bx, x0), std::max(by, y0), std::min(bx + k::kBlock, x1),
+                                std::min(by + k::kBlock, y1)};
+                        if (b.x0 >= b.x1 || b.y0 >= b.y1) continue;
+                        box_bits |= std::uint32_t{1} << blocks.bit(bx, by);
+                        for (int y = by; y < std::min(by + k::kBlock, target.y1); ++y)  // the whole block's depths
+                            for (int x = bx; x < std::min(bx + k::kBlock, target.x1); ++x)
+                                for (int s = 0; s < S; ++s)
+                                    b.farthest = std::min(b.farthest, *target.depth.at(x, y, s));
+                        for (int y = b.y0; y < b.y1; ++y)
+                            for (int x = b.x0; x < b.x1; ++x)
+                                for (int s = 0; s < S; ++s) {
+                                    std::int64_t e[3];
+                                    edges(x, y, s, e);
+                                    ++b.samples;
+                                    if ((e[0] | e[1] | e[2]) < 0) continue;
+                                    ++b.covered;
+                                    const float z = mr::sample_depth(t, mr::screen_weights(t, e[0], e[1], e[2]));
+                                    if (z > *target.depth.at(x, y, s)) b.loses = false;
+                                }
+                        in_box.push_back(b);
+                    }
+                // block_coverage over an extent's corners, which must agree with the samples.
+                const auto coverage = [&](const Block& b) {
+                    const k::BlockCoverage c = k::block_coverage(t, extent(b.x0, b.y0, b.x1, b.y1));
+                    if (c == k::BlockCoverage::none) {
+                        EXPECT_EQ(b.covered, 0);
+                    } else if (c == k::BlockCoverage::all) {
+                        EXPECT_EQ(b.covered, b.samples);
+                    }
+                    return c;
+                };
+                k::BlockClasses expected;
+                const bool whole = x0 == target.x0 && y0 == target.y0 && x1 == target.x1 && y1 == target.y1;
+                Block all{x0, y0, x1, y1};
+                for (const Block& b : in_box) {
+                    all.covered += b.covered, all.samples += b.samples;
+                    all.farthest = std::min(all.farthest, b.farthest);
+                }
+                const k::BlockCoverage target_coverage = whole ? coverage(all) : k::BlockCoverage::some;
+                const float target_bound = k::nearest_depth<mr::DepthFunc::greater>(t, extent(x0, y0, x1, y1));
+                const bool whole_done = target_coverage == k::BlockCoverage::none ||
+                                        (target_coverage == k::BlockCoverage::all && target_bound <= all.farthest);
+                if (whole_done) {
+                    expected.skipped = box_bits;
+                    if (target_coverage == k::BlockCoverage::all) {
+                        expected.skipped_samples = static_cast<std::uint64_t>(all.samples);
+                        expected.depth_rejected = static_cast<int>(in_box.size());
+                    }
+                    ++whole_skipped;
+                } else {
+                    for (const Block& b : in_box) {
+                        if ((b.x1 - b.x0) * (b.y1 - b.y0) < k::kBlockMinPixels) continue;
+                        const std::uint32_t m = std::uint32_t{1} << blocks.bit(b.x0, b.y0);
+                        const k::BlockCoverage c = coverage(b);
+                        if (c == k::BlockCoverage::none) {
+                            expected.skipped |= m;
+                            continue;
+                        }
+                        const float bound = k::nearest_depth<mr::DepthFunc::greater>(t, extent(b.x0, b.y0, b.x1, b.y1));
+                        if (!(bound <= b.farthest)) continue;
+                        ++expected.depth_rejected;
+                        if (c == k::BlockCoverage::some) {
+                            expected.hidden |= m;
+                        } else {
+                            expected.skipped |= m;
+                            expected.skipped_samples += static_cast<std::uint64_t>(b.samples);
+                        }
+                    }
+                }
+                ++compared;
+                ASSERT_EQ(got.skipped, expected.skipped) << "S " << S << ", round " << round << ", step " << step;
+                ASSERT_EQ(got.hidden, expected.hidden) << "S " << S << ", round " << round << ", step " << step;
+                ASSERT_EQ(got.skipped_samples, expected.skipped_samples) << "S " << S << ", round " << round;
+                ASSERT_EQ(got.depth_rejected, expected.depth_rejected) << "S " << S << ", round " << round;
+                for (const Block& b : in_box) {  // rejected by depth: nothing there could win
+                    const std::uint32_t m = std::uint32_t{1} << blocks.bit(b.x0, b.y0);
+                    if ((got.hidden & m) || ((got.skipped & m) && b.covered)) {
+                        ASSERT_TRUE(b.loses);
+                    }
+                }
+                rejected += got.depth_rejected;
+                hidden += __builtin_popcount(got.hidden);
+
+                // Nearer depths in some blocks of the tile, as a triangle's writes would leave them.
+                for (int y = target.y0; y < target.y1; ++y)
+                    for (int x = target.x0; x < target.x1; ++x) {
+                        if ((blocks.bit(x, y) * 7 + step) % 5 != 0) continue;
+                        for (int s = 0; s < S; ++s) {
+                            float& d = *target.depth.at(x, y, s);
+                            d = std::max(d, static_cast<float>(unit(rng)));
+                        }
+                        blocks.written(x, y);
+                    }
+            }
+        }
+    }
+    // The cases the classes come from all occur.
+    EXPECT_GT(compared, 10000);
+    EXPECT_GT(rejected, 1000);
+    EXPECT_GT(hidden, 100);
+    EXPECT_GT(whole_skipped, 300);
 }
 
 TEST(BlockSkipping, SameBitsAndCountersAsThePlainPathOnRandomOverlappingScenes) {

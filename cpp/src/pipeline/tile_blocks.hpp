@@ -57,24 +57,36 @@ inline BlockCoverage block_coverage(const SetupTriangle& t, const SampleExtent& 
 }
 
 /// A float that no sample of t inside the extent has a nearer depth than (sample_depth is ≤ it for
-/// greater, ≥ it for less). Depth is affine in the screen position, so the plane's extremes over
-/// the extent are at its corners; the margin covers rounding, and rounding to float is monotonic.
-/// A NaN anywhere makes the bound NaN, which rejects nothing.
+/// greater, ≥ it for less), from the edge values e1, e2 of edges 1 and 2 (without their bias) at
+/// the extent's corners X0 Y0, X1 Y0, X0 Y1, X1 Y1. Depth is affine in the screen position, so
+/// the plane's extremes over the extent are at its corners; the margin covers rounding, and
+/// rounding to float is monotonic. A NaN anywhere makes the bound NaN, which rejects nothing.
 template <DepthFunc kDepth>
-float nearest_depth(const SetupTriangle& t, const SampleExtent& r) {
+float nearest_depth(const SetupTriangle& t, const std::int64_t (&e1)[4], const std::int64_t (&e2)[4]) {
     constexpr bool kGreater = kDepth == DepthFunc::greater;
     double nearest = kGreater ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
     double reach = 1.0;  // the largest weight magnitude involved, for the margin
     for (int corner = 0; corner < 4; ++corner) {
-        const std::int64_t X = corner & 1 ? r.X1 : r.X0, Y = corner & 2 ? r.Y1 : r.Y0;
-        const double l1 = static_cast<double>(t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1] + t.bias[1]) * t.inv_area2;
-        const double l2 = static_cast<double>(t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2] + t.bias[2]) * t.inv_area2;
+        const double l1 = static_cast<double>(e1[corner] + t.bias[1]) * t.inv_area2;
+        const double l2 = static_cast<double>(e2[corner] + t.bias[2]) * t.inv_area2;
         const double z = t.z0 + l1 * t.dz1 + l2 * t.dz2;
         if (kGreater ? !(z <= nearest) : !(z >= nearest)) nearest = z;  // keeps a NaN
         reach = std::max({reach, std::abs(l1), std::abs(l2)});
     }
     const double margin = kDepthBoundMargin * (std::abs(t.z0) + 2.0 * reach * (std::abs(t.dz1) + std::abs(t.dz2)));
     return static_cast<float>(kGreater ? nearest + margin : nearest - margin);
+}
+
+/// nearest_depth over the samples inside the extent.
+template <DepthFunc kDepth>
+float nearest_depth(const SetupTriangle& t, const SampleExtent& r) {
+    std::int64_t e1[4], e2[4];
+    for (int corner = 0; corner < 4; ++corner) {
+        const std::int64_t X = corner & 1 ? r.X1 : r.X0, Y = corner & 2 ? r.Y1 : r.Y0;
+        e1[corner] = t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1];
+        e2[corner] = t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2];
+    }
+    return nearest_depth<kDepth>(t, e1, e2);
 }
 
 /// What one triangle needs in the blocks of its bounding box, one bit per block (TileBlocks::bit).
@@ -117,12 +129,13 @@ public:
 
     /// The bits of the blocks that hold pixels of [x0, x1) × [y0, y1) (inside the target).
     std::uint32_t blocks_in(int x0, int y0, int x1, int y1) const {
+        static_assert(kBlocksPerSide == 4, "rows of four bits");
         const int column0 = (x0 >> kBlockShift) - bx0_, column1 = ((x1 - 1) >> kBlockShift) - bx0_;
+        const int row0 = (y0 >> kBlockShift) - by0_, row1 = ((y1 - 1) >> kBlockShift) - by0_;
         const std::uint32_t row = (std::uint32_t{2} << column1) - (std::uint32_t{1} << column0);
-        std::uint32_t bits = 0;
-        for (int r = (y0 >> kBlockShift) - by0_; r <= ((y1 - 1) >> kBlockShift) - by0_; ++r)
-            bits |= row << (r * kBlocksPerSide);
-        return bits;
+        // The row repeated at rows row0 … row1: times Σ 16^r = (16^(row1 + 1) − 16^row0) / 15, whose
+        // products with a four-bit row do not overlap.
+        return row * (((std::uint32_t{16} << 4 * row1) - (std::uint32_t{1} << 4 * row0)) / 15);
     }
 
     /// Bit j set where pixel (x0 + j, y) lies in a block of `bits` (j < n ≤ 32).
@@ -173,23 +186,63 @@ private:
         BlockClasses out;
         // A triangle whose bounding box holds the whole target is tested on the target first: under
         // heavy overdraw most such triangles cover all of it behind everything stored, or none of it.
-        if (whole && whole_target<kDepth>(t, S, out)) return out;
-        for (int by = y0 >> kBlockShift; by <= (y1 - 1) >> kBlockShift; ++by) {
+        BlockCoverage coverage_of_target = BlockCoverage::some;  // (all: every block's is all)
+        if (whole && whole_target<kDepth>(t, S, out, coverage_of_target)) return out;
+        // The edge functions' parts along x at the first and last sample columns of each column of
+        // blocks (a·X), and along y at each row of blocks' (b·Y): an edge value at a block's corner
+        // is one of each plus c, the same int64 value block_coverage and nearest_depth compute at
+        // the corner (exact), for 16 products per edge instead of 64 for a tile's 16 blocks.
+        const int column0 = x0 >> kBlockShift, columns = ((x1 - 1) >> kBlockShift) - column0 + 1;
+        const int row0 = y0 >> kBlockShift, rows = ((y1 - 1) >> kBlockShift) - row0 + 1;
+        std::int64_t along_x[3][2][kBlocksPerSide], along_y[3][2][kBlocksPerSide];
+        int width[kBlocksPerSide], height[kBlocksPerSide];
+        for (int c = 0; c < columns; ++c) {
+            const int bx = column0 + c;
+            const int rx0 = std::max(x0, bx << kBlockShift), rx1 = std::min(x1, (bx + 1) << kBlockShift);
+            const std::int64_t X0 = rx0 * kSubpixelOne + ox0_, X1 = (rx1 - 1) * kSubpixelOne + ox1_;  // (extent)
+            width[c] = rx1 - rx0;
+            for (int i = 0; i < 3; ++i) along_x[i][0][c] = t.edge_a[i] * X0, along_x[i][1][c] = t.edge_a[i] * X1;
+        }
+        for (int k = 0; k < rows; ++k) {
+            const int by = row0 + k;
             const int ry0 = std::max(y0, by << kBlockShift), ry1 = std::min(y1, (by + 1) << kBlockShift);
-            for (int bx = x0 >> kBlockShift; bx <= (x1 - 1) >> kBlockShift; ++bx) {
-                const int rx0 = std::max(x0, bx << kBlockShift), rx1 = std::min(x1, (bx + 1) << kBlockShift);
-                const int pixels = (rx1 - rx0) * (ry1 - ry0);
+            const std::int64_t Y0 = ry0 * kSubpixelOne + oy0_, Y1 = (ry1 - 1) * kSubpixelOne + oy1_;
+            height[k] = ry1 - ry0;
+            for (int i = 0; i < 3; ++i) along_y[i][0][k] = t.edge_b[i] * Y0, along_y[i][1][k] = t.edge_b[i] * Y1;
+        }
+        for (int k = 0; k < rows; ++k) {
+            for (int c = 0; c < columns; ++c) {
+                const int pixels = width[c] * height[k];
                 if (pixels < kBlockMinPixels) continue;
-                const std::uint32_t m = std::uint32_t{1} << ((by - by0_) * kBlocksPerSide + bx - bx0_);
-                // Where the samples of the pixels [rx0, rx1) × [ry0, ry1) lie.
-                const SampleExtent r = extent(rx0, ry0, rx1, ry1);
-                const BlockCoverage coverage = block_coverage(t, r);
+                const std::uint32_t m = std::uint32_t{1} << ((row0 + k - by0_) * kBlocksPerSide + column0 + c - bx0_);
+                // block_coverage: each edge's largest and smallest value at the corners its a and b pick.
+                BlockCoverage coverage = coverage_of_target;
+                if (coverage != BlockCoverage::all) {
+                    coverage = BlockCoverage::all;
+                    for (int i = 0; i < 3; ++i) {
+                        const bool right = t.edge_a[i] >= 0, down = t.edge_b[i] >= 0;
+                        if (along_x[i][right][c] + along_y[i][down][k] + t.edge_c[i] < 0) {
+                            coverage = BlockCoverage::none;
+                            break;
+                        }
+                        if (along_x[i][!right][c] + along_y[i][!down][k] + t.edge_c[i] < 0)
+                            coverage = BlockCoverage::some;
+                    }
+                }
                 if (coverage == BlockCoverage::none) {
                     out.skipped |= m;
                     continue;
                 }
                 if constexpr (kDepth != DepthFunc::none) {
-                    if (!hidden<kDepth>(t, m, r)) continue;
+                    known_farthest<kDepth>(m);
+                    std::int64_t e1[4], e2[4];  // at the corners, in nearest_depth's order
+                    for (int corner = 0; corner < 4; ++corner) {
+                        e1[corner] = along_x[1][corner & 1][c] + along_y[1][corner >> 1][k] + t.edge_c[1];
+                        e2[corner] = along_x[2][corner & 1][c] + along_y[2][corner >> 1][k] + t.edge_c[2];
+                    }
+                    const float nearest = nearest_depth<kDepth>(t, e1, e2);
+                    const float farthest = farthest_[__builtin_ctz(m)];
+                    if (!(kDepth == DepthFunc::greater ? nearest <= farthest : nearest >= farthest)) continue;
                     ++out.depth_rejected;
                     if (coverage == BlockCoverage::some) {
                         out.hidden |= m;
@@ -209,13 +262,14 @@ private:
                 std::int64_t{x1 - 1} * kSubpixelOne + ox1_, std::int64_t{y1 - 1} * kSubpixelOne + oy1_};
     }
 
-    // When t covers no sample of the target, or covers all and all fail the depth test: every
-    // block skipped, and true. The samples are counted as the blocks one by one would count them
-    // (depth_rejected also counts blocks too thin to classify one by one, at a viewport's edge).
+    // When t covers no sample of the target, or covers all and all fail the depth test: every block
+    // skipped, and true. `coverage`: t's over the whole target. The samples are counted as the blocks
+    // one by one would count them (depth_rejected also counts blocks too thin to classify one by one,
+    // at a viewport's edge).
     template <DepthFunc kDepth>
-    bool whole_target(const SetupTriangle& t, int S, BlockClasses& out) {
+    bool whole_target(const SetupTriangle& t, int S, BlockClasses& out, BlockCoverage& coverage) {
         const SampleExtent r = extent(target_.x0, target_.y0, target_.x1, target_.y1);
-        const BlockCoverage coverage = block_coverage(t, r);
+        coverage = block_coverage(t, r);
         if (coverage == BlockCoverage::none) {
             out.skipped = blocks_in(target_.x0, target_.y0, target_.x1, target_.y1);
             return true;
@@ -224,11 +278,19 @@ private:
         else {
             if (coverage != BlockCoverage::all) return false;
             const std::uint32_t blocks = blocks_in(target_.x0, target_.y0, target_.x1, target_.y1);
+            constexpr bool kGreater = kDepth == DepthFunc::greater;
             const float nearest = nearest_depth<kDepth>(t, r);
-            for (std::uint32_t m = blocks; m; m &= m - 1) {  // hidden behind every block's farthest depth
-                known_farthest<kDepth>(m & -m);
-                const float farthest = farthest_[__builtin_ctz(m)];
-                if (!(kDepth == DepthFunc::greater ? nearest <= farthest : nearest >= farthest)) return false;
+            if (!(kGreater ? nearest <= target_farthest_ : nearest >= target_farthest_)) {
+                constexpr float kInfinity = std::numeric_limits<float>::infinity();
+                float farthest_of_all = kGreater ? kInfinity : -kInfinity;
+                for (std::uint32_t m = blocks; m; m &= m - 1) {  // hidden behind every block's farthest depth
+                    known_farthest<kDepth>(m & -m);
+                    const float farthest = farthest_[__builtin_ctz(m)];
+                    if (!(kGreater ? nearest <= farthest : nearest >= farthest)) return false;
+                    farthest_of_all =
+                        kGreater ? std::min(farthest_of_all, farthest) : std::max(farthest_of_all, farthest);
+                }
+                target_farthest_ = farthest_of_all;
             }
             out.skipped = blocks;
             out.skipped_samples = static_cast<std::uint64_t>(target_.x1 - target_.x0) *
@@ -245,17 +307,6 @@ private:
             farthest_[__builtin_ctz(m)] = farthest_stored<kDepth>(__builtin_ctz(m));
             known_ |= m;
         }
-    }
-
-    // Whether every sample of t inside the extent (in block m) fails the depth test:
-    // its z is at most (at least) `nearest` and every stored depth at least (at most) the block's
-    // farthest, so z > stored (z < stored) cannot hold.
-    template <DepthFunc kDepth>
-    bool hidden(const SetupTriangle& t, std::uint32_t m, const SampleExtent& r) {
-        known_farthest<kDepth>(m);
-        const float nearest = nearest_depth<kDepth>(t, r);
-        const float farthest = farthest_[__builtin_ctz(m)];
-        return kDepth == DepthFunc::greater ? nearest <= farthest : nearest >= farthest;
     }
 
     // The farthest stored depth of block b within the target: the smallest for greater, the
@@ -292,6 +343,10 @@ private:
     std::int32_t ox0_, ox1_, oy0_, oy1_;  ///< the extremes of the sample offsets, in 1/256 px
     std::uint32_t known_ = 0;  ///< blocks whose farthest_ is current
     float farthest_[kBlocksPerSide * kBlocksPerSide];
+    /// No nearer than the farthest depth of every block of the target (NaN: none known yet). Kept
+    /// from the last time whole_target looked at every block: depths written since then only moved
+    /// nearer, so it stays a bound, and a triangle behind it is behind every block without the look.
+    float target_farthest_ = std::numeric_limits<float>::quiet_NaN();
 };
 
 }  // namespace kernels
