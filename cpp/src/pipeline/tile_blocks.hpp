@@ -240,6 +240,8 @@ private:
                         e1[corner] = along_x[1][corner & 1][c] + along_y[1][corner >> 1][k] + t.edge_c[1];
                         e2[corner] = along_x[2][corner & 1][c] + along_y[2][corner >> 1][k] + t.edge_c[2];
                     }
+                    // Behind: no sample of t nearer than `nearest`, no stored depth farther than
+                    // `farthest`, so every depth test in the block fails.
                     const float nearest = nearest_depth<kDepth>(t, e1, e2);
                     const float farthest = farthest_[__builtin_ctz(m)];
                     if (!(kDepth == DepthFunc::greater ? nearest <= farthest : nearest >= farthest)) continue;
