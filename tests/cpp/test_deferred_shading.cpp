@@ -2,8 +2,9 @@
 // replaces, a visibility pre-pass and one shade per visible sample give the image of shading while
 // rasterizing, bit for bit — colour, depth and every counter but shader_invocations — for every
 // shading, texturing, depth setting, sample mode and thread count; the shader then runs exactly once
-// per sample that ends up drawn. MSAA renders are never deferred, nor tiles with a blended or
-// alpha-tested triangle.
+// per sample that ends up drawn (MSAA: once per pixel and owning triangle, where that triangle's draw
+// shades the pixel). MSAA tiles are deferred only from a deeper overdraw; tiles with a blended or
+// alpha-tested triangle never are.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include <iostream>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "helpers.hpp"
@@ -59,7 +61,8 @@ TEST(DeferredShading, SameBitsAsShadingWhileRasterizingOnOverlappingScenes) {
     bilinear.mip_filter = mr::MipFilter::none;  // no derivatives: the fixed texturing kernel
     for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
         const mr::Camera cam = overlap_camera(convention, W, H);
-        for (int samples : {1, 4})
+        for (const auto& [aa, samples] : {std::pair{mr::AntiAliasing::ssaa, 1}, std::pair{mr::AntiAliasing::ssaa, 4},
+                                         std::pair{mr::AntiAliasing::msaa, 4}})
             for (mr::Interpolation interpolation :
                  {mr::Interpolation::perspective, mr::Interpolation::screen, mr::Interpolation::flat}) {
                 mr::DrawState tested;
@@ -76,10 +79,13 @@ TEST(DeferredShading, SameBitsAsShadingWhileRasterizingOnOverlappingScenes) {
                 draws[2].texture = texture;
                 draws[2].sampler = bilinear;
                 draws[3].mesh = &b;
+                if (aa == mr::AntiAliasing::msaa)  // (under MSAA only textured draws are deferred)
+                    for (mr::Draw* d : {&draws[1], &draws[3]}) d->texture = texture, d->sampler = trilinear;
                 for (int threads : {1, 2}) {
-                    SCOPED_TRACE(mr::to_string(convention) + ", " + std::to_string(samples) + " samples, " +
-                                 mr::to_string(interpolation) + ", " + std::to_string(threads) + " threads");
+                    SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(aa) + " " + std::to_string(samples) +
+                                 ", " + mr::to_string(interpolation) + ", " + std::to_string(threads) + " threads");
                     auto s = settings(W, H, samples);
+                    s.anti_aliasing = aa;
                     s.threads = threads;
                     s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
                     const Outcome o = render_both(draws, cam, s);
@@ -184,9 +190,57 @@ TEST(DeferredShading, UntexturedTilesAreDeferredOnlyWithBigEnoughTriangles) {
     }
 }
 
+// `layers` textured quads over the whole W × H viewport (positions in 1/256 px: fixed_to_ndc), each
+// nearer than the one before: every tile's overdraw is `layers`.
+mr::Mesh layered_quads(int layers, int W, int H) {
+    mr::Mesh m;
+    for (int k = 0; k < layers; ++k) {
+        const float z = 0.8f - 0.3f * static_cast<float>(k);  // (OpenGL depth: nearer is smaller)
+        const auto first = static_cast<std::uint32_t>(m.positions.size());
+        for (const glm::vec2 corner : {glm::vec2(0, 0), glm::vec2(1, 0), glm::vec2(1, 1), glm::vec2(0, 1)}) {
+            m.positions.push_back({corner.x * W * 256.0f, corner.y * H * 256.0f, z});
+            m.uvs.push_back(corner * (1.5f + static_cast<float>(k)));
+        }
+        add_triangle(m, first, first + 1, first + 2);
+        add_triangle(m, first, first + 2, first + 3);
+    }
+    return m;
+}
+
+// Overdraw 2 defers tiles at one sample and under SSAA, not under MSAA (kDeferredMinOverdrawMsaa:
+// 3); overdraw 4 defers them under MSAA too, with the forward image.
+TEST(DeferredShading, MsaaTilesAreDeferredFromADeeperOverdraw) {
+    const int W = 64, H = 64;
+    for (const auto& [layers, aa, samples, deferred] :
+         {std::tuple{2, mr::AntiAliasing::ssaa, 1, true}, std::tuple{2, mr::AntiAliasing::ssaa, 4, true},
+          std::tuple{2, mr::AntiAliasing::msaa, 4, false}, std::tuple{4, mr::AntiAliasing::msaa, 4, true}}) {
+        SCOPED_TRACE(std::to_string(layers) + " layers, " + mr::to_string(aa) + " " + std::to_string(samples));
+        const mr::Mesh quads = layered_quads(layers, W, H);
+        mr::Draw draw = make_draw(quads, fixed_to_ndc(W, H), {});
+        draw.texture = checker_texture();
+        auto s = settings(W, H, samples);
+        s.anti_aliasing = aa;
+        const Outcome o = render_both({draw}, identity_camera(), s);
+        expect_same_image(o);
+        EXPECT_EQ(o.deferred.stats.tiles_deferred, deferred ? 4u : 0u);
+        // Deferred: one shade per sample, the nearest layer's; under MSAA one per pixel, and two
+        // where the diagonal between the nearest quad's triangles splits a pixel's samples.
+        const std::uint64_t shades = o.deferred.stats.shader_invocations, pixels = std::uint64_t(W) * H;
+        if (!deferred) {
+            EXPECT_EQ(shades, o.forward.stats.shader_invocations);
+        } else if (aa == mr::AntiAliasing::msaa) {
+            EXPECT_GE(shades, pixels);
+            EXPECT_LE(shades, pixels + 2 * W);
+            EXPECT_GT(o.forward.stats.shader_invocations, 3 * pixels);
+        } else {
+            EXPECT_EQ(shades, pixels * samples);
+        }
+    }
+}
+
 TEST(DeferredShading, BlendingMsaaAndShallowScenesShadeWhileRasterizing) {
     const int W = 64, H = 64;
-    const mr::Mesh deep = overlapping(200, 2.5, 61), shallow = overlapping(3, 0.3, 62);
+    const mr::Mesh deep = overlapping(200, 2.5, 61), shallow = overlapping(3, 0.3, 62), two_layers = layered_quads(2, W, H);
     const mr::Camera cam = overlap_camera(mr::DepthConvention::reverse_z, W, H);
     mr::DrawState over;
     over.blend = mr::BlendMode::over;
@@ -199,7 +253,7 @@ TEST(DeferredShading, BlendingMsaaAndShallowScenesShadeWhileRasterizing) {
     const Case cases[] = {
         {"one blended draw among opaque ones", {make_draw(deep, glm::dmat4(1.0), {}), make_draw(deep, glm::dmat4(1.0), over)},
          mr::AntiAliasing::ssaa, 4},
-        {"msaa", {make_draw(deep, glm::dmat4(1.0), {})}, mr::AntiAliasing::msaa, 4},
+        {"msaa over two layers", {make_draw(two_layers, fixed_to_ndc(W, H), {})}, mr::AntiAliasing::msaa, 4},
         {"few small triangles", {make_draw(shallow, glm::dmat4(1.0), {})}, mr::AntiAliasing::ssaa, 4},
     };
     for (const Case& c : cases) {

@@ -622,21 +622,33 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     if (!passed) continue;
                     if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
                     counters.samples_passed += static_cast<std::uint64_t>(count_bits(passed));
-                    ++counters.shader_invocations;
-                    glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
-                    if constexpr (!((kShading == Shading::constant || kShading == Shading::flat) &&
-                                    kTexturing == Texturing::none)) {
-                        std::int64_t c0 = p0 + to_centre0, c1 = p1 + to_centre1, c2 = p2 + to_centre2;
-                        if ((c0 | c1 | c2) < 0) {
-                            const int s = __builtin_ctzll(passed);
-                            c0 = p0 + off0[s];
-                            c1 = p1 + off1[s];
-                            c2 = p2 + off2[s];
+                    const bool at_centre = ((p0 + to_centre0) | (p1 + to_centre1) | (p2 + to_centre2)) >= 0;
+                    if constexpr (kShading == Shading::visibility) {
+                        // Deferred shading's pre-pass: the samples' owner, and where it would shade
+                        // the pixel (shade_owned shades there, the shade below).
+                        const std::size_t first = target.owner_index(px, py, 0, S);
+                        const auto at = static_cast<std::uint8_t>(at_centre ? kShadeAtCentre : __builtin_ctzll(passed));
+                        for (std::uint64_t m = passed; m; m &= m - 1) {
+                            target.owners[first + __builtin_ctzll(m)] = owner;
+                            target.owner_shade_at[first + __builtin_ctzll(m)] = at;
                         }
-                        l = screen_weights(t, c0, c1, c2);
+                    } else {
+                        ++counters.shader_invocations;
+                        glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
+                        if constexpr (!((kShading == Shading::constant || kShading == Shading::flat) &&
+                                        kTexturing == Texturing::none)) {
+                            std::int64_t c0 = p0 + to_centre0, c1 = p1 + to_centre1, c2 = p2 + to_centre2;
+                            if (!at_centre) {
+                                const int s = __builtin_ctzll(passed);
+                                c0 = p0 + off0[s];
+                                c1 = p1 + off1[s];
+                                c2 = p2 + off2[s];
+                            }
+                            l = screen_weights(t, c0, c1, c2);
+                        }
+                        shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px, passed, draw,
+                                                                 colors, uvs, t, l, batch.clip_weights, px, py);
                     }
-                    shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px, passed, draw, colors, uvs,
-                                                             t, l, batch.clip_weights, px, py);
                 } else {
                     // Shade every covered sample that passes the depth test.
                     float* const color_px = colour_slots(px, py);
@@ -761,6 +773,72 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
                 }
             }
         }
+    } else if (target.owner_shade_at) {
+        // MSAA: the samples of a pixel with one owner, shaded once where the owner's draw shaded the
+        // pixel (its centre, or a sample) and stored to all of them, as that draw did.
+        const std::uint64_t all = S == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << S) - 1;
+        const auto centre_edges = [&](int px, int py, std::int64_t (&e)[3]) {
+            const SetupTriangle& t = *ref.triangle;
+            const std::int64_t X = std::int64_t{px} * kSubpixelOne + kSubpixelOne / 2;
+            const std::int64_t Y = std::int64_t{py} * kSubpixelOne + kSubpixelOne / 2;
+            for (int i = 0; i < 3; ++i) e[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+        };
+        const auto shade_pixel = [&](int px, int py) {
+            const std::size_t first = target.owner_index(px, py, 0, S);
+            for (std::uint64_t left = all; left;) {
+                const int s = __builtin_ctzll(left);
+                const std::int32_t owner = target.owners[first + s];
+                const std::uint8_t at = target.owner_shade_at[first + s];  // (one per owner: it drew the pixel once)
+                std::uint64_t samples = 0;  // the pixel's samples with this owner
+                for (std::uint64_t m = left; m; m &= m - 1)
+                    if (target.owners[first + __builtin_ctzll(m)] == owner) samples |= m & -m;
+                left &= ~samples;
+                if (owner < 0 || !take(owner)) continue;
+                std::int64_t e[3];
+                if (at == kShadeAtCentre) centre_edges(px, py, e);
+                else edges_at(px, py, at, e);
+                ++counters.shader_invocations;
+                shade_into<BlendMode::replace, kShading, kTexturing>(
+                    queue ? &*queue : nullptr, target.color.at(px, py, 0), samples, draw, colors, uvs, *ref.triangle,
+                    screen_weights(*ref.triangle, e[0], e[1], e[2]), ref.clip_weights, px, py);
+            }
+        };
+        // Runs of pixels whose samples all have one owner that shades them at their centres go to
+        // the lookup queue a row at a time, their weights as the forward kernel's long rows take them.
+        const auto whole_at_centre = [&](int px, int py, std::int32_t owner) {
+            const std::size_t first = target.owner_index(px, py, 0, S);
+            for (int s = 0; s < S; ++s)
+                if (target.owners[first + s] != owner || target.owner_shade_at[first + s] != kShadeAtCentre)
+                    return false;
+            return true;
+        };
+        std::uint64_t all_samples[kTileSize];
+        std::fill(all_samples, all_samples + kTileSize, all);
+        double l0[kTileSize], l1[kTileSize], l2[kTileSize];
+        for (int py = target.y0; py < target.y1; ++py)
+            for (int px = target.x0; px < target.x1;) {
+                const std::int32_t owner = target.owners[target.owner_index(px, py, 0, S)];
+                int end = px;
+                if (queue && owner >= 0)
+                    while (end < target.x1 && whole_at_centre(end, py, owner)) ++end;
+                if (end - px < kSampleRowMinPixels) {
+                    shade_pixel(px++, py);
+                    continue;
+                }
+                if (take(owner)) {  // (else another draw's pixels)
+                    std::int64_t centre[3];
+                    centre_edges(px, py, centre);
+                    const int n = end - px;
+                    if (sample_row_weights(*ref.triangle, centre, n, l0, l1, l2)) {
+                        counters.shader_invocations += static_cast<std::uint64_t>(n);
+                        queue->push_row(target.color.at(px, py, 0), 4 * S, ~std::uint32_t{0} >> (32 - n), l0, l1, l2,
+                                        px, py, all_samples);
+                    } else {
+                        for (int x = px; x < end; ++x) shade_pixel(x, py);
+                    }
+                }
+                px = end;
+            }
     } else {
         for (int py = target.y0; py < target.y1; ++py)
             for (int px = target.x0; px < target.x1; ++px)
@@ -774,7 +852,7 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
 
 template <Texturing T>
 OwnedShadingKernel pick_owned_shading(const PipelineKey& k) {
-    if (k.blend != BlendMode::replace || k.samples == SampleMode::msaa) return nullptr;
+    if (k.blend != BlendMode::replace) return nullptr;
     switch (k.shading) {
         case Shading::constant: return &shade_owned<Shading::constant, T>;
         case Shading::flat: return &shade_owned<Shading::flat, T>;
@@ -828,13 +906,17 @@ TileKernel pick_depth(const PipelineKey& k) {
     return nullptr;
 }
 
-// Visibility records every covered sample that passes the depth test: no blending, no MSAA.
+// Visibility records every covered sample that passes the depth test: no blending; MSAA only as
+// deferred shading's pre-pass (with owners).
 template <DepthFunc D>
 TileKernel pick_visibility(SampleMode m) {
     using V = Texturing;
-    return m == SampleMode::single
-               ? &raster_tile<D, BlendMode::replace, Shading::visibility, SampleMode::single, V::none>
-               : &raster_tile<D, BlendMode::replace, Shading::visibility, SampleMode::ssaa, V::none>;
+    switch (m) {
+        case SampleMode::single: return &raster_tile<D, BlendMode::replace, Shading::visibility, SampleMode::single, V::none>;
+        case SampleMode::ssaa: return &raster_tile<D, BlendMode::replace, Shading::visibility, SampleMode::ssaa, V::none>;
+        case SampleMode::msaa: return &raster_tile<D, BlendMode::replace, Shading::visibility, SampleMode::msaa, V::none>;
+    }
+    return nullptr;
 }
 
 /// The instances of one kind of texturing (defined in raster_kernels_*.cpp).

@@ -378,13 +378,13 @@ bool tile_deferrable(std::size_t tile, const std::vector<BinnedChunk>& chunks, c
 }
 
 // Whether deferring the tile's shading pays (with RenderSettings::deferred_shading): overdraw
-// from kDeferredMinOverdraw on, and for a tile without textures also big enough triangles
+// from min_overdraw on (kDeferredMinOverdraw, or kDeferredMinOverdrawMsaa), and for a tile without textures also big enough triangles
 // (kDeferredMinUntexturedGain). `deferrable`: per draw, whether it may be deferred; every_draw:
 // all may (else the tile's triangles are checked).
 bool defer_tile(std::size_t tile, const std::vector<BinnedChunk>& chunks, const std::vector<DrawInputs>& inputs,
-                const std::vector<char>& deferrable, bool every_draw, const TileTarget& target) {
+                const std::vector<char>& deferrable, bool every_draw, double min_overdraw, const TileTarget& target) {
     const double overdraw = tile_overdraw(tile, chunks, target);
-    if (overdraw < kDeferredMinOverdraw) return false;
+    if (overdraw < min_overdraw) return false;
     if (!every_draw && !tile_deferrable(tile, chunks, deferrable)) return false;
     std::size_t triangles = 0;
     bool textured = false;
@@ -401,18 +401,25 @@ bool defer_tile(std::size_t tile, const std::vector<BinnedChunk>& chunks, const 
 
 // Deferred shading of one tile (RenderSettings::deferred_shading): the pre-pass rasterizes and
 // depth-tests every triangle as the forward kernels would, recording for each sample the triangle
-// it ends up with; then each draw shades the samples its triangles own, once each.
+// it ends up with (MSAA: and where that triangle shades the pixel); then each draw shades the
+// samples its triangles own, once each (MSAA: once per pixel and owner).
 void rasterize_tile_deferred(std::size_t tile, const std::vector<BinnedChunk>& chunks,
                              const std::vector<TileKernel>& prepass_kernels,
                              const std::vector<OwnedShadingKernel>& shading_kernels, const std::vector<DrawInputs>& inputs,
-                             const TileTarget& target, TileCounters& counters) {
+                             const TileTarget& target, bool msaa, TileCounters& counters) {
     thread_local std::vector<std::int32_t> owners;
+    thread_local std::vector<std::uint8_t> shade_at;
     thread_local std::vector<OwnerRef> refs;
-    owners.assign(std::size_t{kTileSize} * kTileSize * static_cast<std::size_t>(target.color.samples), -1);
+    const std::size_t samples = std::size_t{kTileSize} * kTileSize * static_cast<std::size_t>(target.color.samples);
+    owners.assign(samples, -1);
     refs.clear();
     TileTarget deferred = target;
     deferred.owners = owners.data();
     deferred.owner_refs = &refs;
+    if (msaa) {
+        shade_at.resize(samples);  // (written with each owner)
+        deferred.owner_shade_at = shade_at.data();
+    }
     rasterize_tile_chunks(tile, chunks, prepass_kernels, inputs, deferred, counters);
     // refs follow submission order: each draw's triangles come together.
     for (std::size_t i = 0; i < refs.size();) {
@@ -587,6 +594,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     // (its samples keep the depth of what lies behind wherever its shade is discarded: the
     // pre-pass, which shades nothing, cannot know which triangle a sample ends up with). A tile
     // is deferred only when all its triangles' draws may be.
+    const bool msaa = settings.samples > 1 && settings.anti_aliasing == AntiAliasing::msaa;
     std::vector<char> deferrable(draws.size());
     std::vector<DrawInputs> inputs(draws.size());
     std::vector<std::unique_ptr<TextureView>> textures(draws.size());  // pinned for the render
@@ -600,7 +608,10 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         prepass.shading = Shading::visibility;
         prepass_kernels[d] = select_tile_kernel(prepass);
         shading_kernels[d] = select_owned_shading_kernel(key);
-        deferrable[d] = settings.deferred_shading && shading_kernels[d] && !draws[d].state.alpha_cutoff;
+        // (Not untextured draws under MSAA, whose one cheap shade per pixel leaves the pre-pass little
+        // to save: their renders then skip the overlap estimate, as before MSAA was deferred.)
+        deferrable[d] = settings.deferred_shading && shading_kernels[d] && !draws[d].state.alpha_cutoff &&
+                        !(msaa && !draws[d].texture);
         const Mesh& mesh = *draws[d].mesh;
         inputs[d] = {mesh.triangles.data(), mesh.has_colors() ? mesh.colors.data() : nullptr, draws[d].color,
                      draws[d].state.depth_write, draws[d].state.alpha_cutoff};
@@ -623,13 +634,14 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     const bool every_draw_deferrable = std::find(deferrable.begin(), deferrable.end(), 0) == deferrable.end();
 
     // Stage 2: clip, set up and bin (with the per-tile overlap estimate only where a tile may be
-    // deferred; defer_tile asks no more of a tile with a textured draw than kDeferredMinOverdraw).
+    // deferred; defer_tile asks no more of a tile with a textured draw than min_overdraw).
     t0 = Clock::now();
+    const double min_overdraw = msaa ? kDeferredMinOverdrawMsaa : kDeferredMinOverdraw;
     const TileGrid grid = TileGrid::for_viewport(settings.width, settings.height);
     std::vector<double> enough_overdraw;
     if (deferred)
         for (const DrawInputs& input : inputs)
-            enough_overdraw.push_back(input.texture ? kDeferredMinOverdraw : std::numeric_limits<double>::infinity());
+            enough_overdraw.push_back(input.texture ? min_overdraw : std::numeric_limits<double>::infinity());
     const std::vector<BinnedChunk> chunks =
         setup_and_bin(geometry, volume, viewport, grid, enough_overdraw, pool, stats);
     stats.setup_ms = ms_since(t0);
@@ -738,8 +750,9 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 target.color.fill(target.x0, target.y0, target.x1, target.y1, settings.clear_color);
                 if (needs_depth) target.depth.fill(target.x0, target.y0, target.x1, target.y1, clear_depth4);
             }
-            if (deferred && defer_tile(tile, chunks, inputs, deferrable, every_draw_deferrable, target))
-                rasterize_tile_deferred(tile, chunks, prepass_kernels, shading_kernels, inputs, target, counters);
+            if (deferred && defer_tile(tile, chunks, inputs, deferrable, every_draw_deferrable, min_overdraw, target))
+                rasterize_tile_deferred(tile, chunks, prepass_kernels, shading_kernels, inputs, target,
+                                        msaa, counters);
             else
                 rasterize_tile_chunks(tile, chunks, kernels, inputs, target, counters);
         }

@@ -48,6 +48,9 @@ struct OwnerRef {
 
 /// The pixel rectangle [x0, x1) × [y0, y1) of one tile and the sample storage it writes: RGBA
 /// colour and (when some draw tests depth) depth, each a window that covers the rectangle.
+/// TileTarget::owner_shade_at of a pixel shaded at its centre.
+inline constexpr std::uint8_t kShadeAtCentre = 0xff;
+
 struct TileTarget {
     SampleWindow color, depth;
     const SamplePattern* pattern;
@@ -67,6 +70,9 @@ struct TileTarget {
     /// up with, or −1; the shading pass then shades each sample once, with that triangle.
     std::int32_t* owners = nullptr;
     std::vector<OwnerRef>* owner_refs = nullptr;
+    /// MSAA only, indexed like `owners`: where the owner shades the sample's pixel (MSAA shades a
+    /// pixel once per triangle): kShadeAtCentre, or the index of the sample whose position it takes.
+    std::uint8_t* owner_shade_at = nullptr;
     /// Sample s of pixel (x, y) in `owners`: the tile's pixels row by row from (x0, y0), kTileSize
     /// per row, S samples each.
     std::size_t owner_index(int x, int y, int s, int S) const {

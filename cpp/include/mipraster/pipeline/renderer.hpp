@@ -67,11 +67,13 @@ struct RenderSettings {
     /// output and counters are the same bits either way; false runs the per-sample path, for
     /// comparison.
     bool sample_rows = true;
-    /// Where a tile's triangles overlap kDeferredMinOverdraw deep or more and every one of them is
-    /// of a draw that replaces without an alpha test (at 1 sample or SSAA), shade only the samples
-    /// that stay visible: a pre-pass records which triangle each sample ends up with, then each
-    /// sample is shaded once. The image is the same bit for bit, and so are the counters but
-    /// shader_invocations; false always shades while rasterizing, for comparison.
+    /// Where a tile's triangles overlap kDeferredMinOverdraw deep or more (MSAA: textured draws,
+    /// kDeferredMinOverdrawMsaa) and every one of them is of a draw that replaces without an alpha
+    /// test, shade only the samples that stay visible: a pre-pass records which triangle each
+    /// sample ends up with, then each sample is shaded once (MSAA: each pixel once per triangle it
+    /// ends up with, where that triangle's draw shaded it). The image is the same bit for bit, and
+    /// so are the counters but shader_invocations; false always shades while rasterizing, for
+    /// comparison.
     bool deferred_shading = true;
     /// Textured draws look their texture up sixteen samples at a time in float vectors where the
     /// sampler allows (BatchSampler: bilinear or trilinear, repeat or clamp), each value within
