@@ -240,7 +240,8 @@ TEST(DeferredShading, MsaaTilesAreDeferredFromADeeperOverdraw) {
 
 TEST(DeferredShading, BlendingMsaaAndShallowScenesShadeWhileRasterizing) {
     const int W = 64, H = 64;
-    const mr::Mesh deep = overlapping(200, 2.5, 61), shallow = overlapping(3, 0.3, 62), two_layers = layered_quads(2, W, H);
+    const mr::Mesh deep = overlapping(200, 2.5, 61), shallow = overlapping(3, 0.3, 62);
+    const mr::Mesh two_layers = layered_quads(2, W, H);
     const mr::Camera cam = overlap_camera(mr::DepthConvention::reverse_z, W, H);
     mr::DrawState over;
     over.blend = mr::BlendMode::over;

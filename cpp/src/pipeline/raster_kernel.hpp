@@ -910,11 +910,12 @@ TileKernel pick_depth(const PipelineKey& k) {
 // deferred shading's pre-pass (with owners).
 template <DepthFunc D>
 TileKernel pick_visibility(SampleMode m) {
-    using V = Texturing;
+    constexpr BlendMode kReplace = BlendMode::replace;
+    constexpr Shading kVisibility = Shading::visibility;
     switch (m) {
-        case SampleMode::single: return &raster_tile<D, BlendMode::replace, Shading::visibility, SampleMode::single, V::none>;
-        case SampleMode::ssaa: return &raster_tile<D, BlendMode::replace, Shading::visibility, SampleMode::ssaa, V::none>;
-        case SampleMode::msaa: return &raster_tile<D, BlendMode::replace, Shading::visibility, SampleMode::msaa, V::none>;
+        case SampleMode::single: return &raster_tile<D, kReplace, kVisibility, SampleMode::single, Texturing::none>;
+        case SampleMode::ssaa: return &raster_tile<D, kReplace, kVisibility, SampleMode::ssaa, Texturing::none>;
+        case SampleMode::msaa: return &raster_tile<D, kReplace, kVisibility, SampleMode::msaa, Texturing::none>;
     }
     return nullptr;
 }

@@ -377,10 +377,10 @@ bool tile_deferrable(std::size_t tile, const std::vector<BinnedChunk>& chunks, c
     return true;
 }
 
-// Whether deferring the tile's shading pays (with RenderSettings::deferred_shading): overdraw
-// from min_overdraw on (kDeferredMinOverdraw, or kDeferredMinOverdrawMsaa), and for a tile without textures also big enough triangles
-// (kDeferredMinUntexturedGain). `deferrable`: per draw, whether it may be deferred; every_draw:
-// all may (else the tile's triangles are checked).
+// Whether deferring the tile's shading pays (with RenderSettings::deferred_shading): overdraw from
+// min_overdraw on (kDeferredMinOverdraw, or kDeferredMinOverdrawMsaa), and for a tile without
+// textures also big enough triangles (kDeferredMinUntexturedGain). `deferrable`: per draw, whether
+// it may be deferred; every_draw: all may (else the tile's triangles are checked).
 bool defer_tile(std::size_t tile, const std::vector<BinnedChunk>& chunks, const std::vector<DrawInputs>& inputs,
                 const std::vector<char>& deferrable, bool every_draw, double min_overdraw, const TileTarget& target) {
     const double overdraw = tile_overdraw(tile, chunks, target);
