@@ -46,11 +46,11 @@ struct OwnerRef {
     const ClipWeights* clip_weights;
 };
 
-/// The pixel rectangle [x0, x1) × [y0, y1) of one tile and the sample storage it writes: RGBA
-/// colour and (when some draw tests depth) depth, each a window that covers the rectangle.
 /// TileTarget::owner_shade_at of a pixel shaded at its centre.
 inline constexpr std::uint8_t kShadeAtCentre = 0xff;
 
+/// The pixel rectangle [x0, x1) × [y0, y1) of one tile and the sample storage it writes: RGBA
+/// colour and (when some draw tests depth) depth, each a window that covers the rectangle.
 struct TileTarget {
     SampleWindow color, depth;
     const SamplePattern* pattern;
