@@ -89,6 +89,13 @@ float nearest_depth(const SetupTriangle& t, const SampleExtent& r) {
     return nearest_depth<kDepth>(t, e1, e2);
 }
 
+/// Whether samples no nearer than `nearest` (nearest_depth) all fail the depth test against stored
+/// depths no farther than `farthest`: z > stored (z < stored) cannot hold. False for a NaN.
+template <DepthFunc kDepth>
+inline bool behind(float nearest, float farthest) {
+    return kDepth == DepthFunc::greater ? nearest <= farthest : nearest >= farthest;
+}
+
 /// What one triangle needs in the blocks of its bounding box, one bit per block (TileBlocks::bit).
 struct BlockClasses {
     std::uint32_t skipped = 0;  ///< no per-pixel work: covers no sample, or covers all and is hidden
@@ -240,11 +247,7 @@ private:
                         e1[corner] = along_x[1][corner & 1][c] + along_y[1][corner >> 1][k] + t.edge_c[1];
                         e2[corner] = along_x[2][corner & 1][c] + along_y[2][corner >> 1][k] + t.edge_c[2];
                     }
-                    // Behind: no sample of t nearer than `nearest`, no stored depth farther than
-                    // `farthest`, so every depth test in the block fails.
-                    const float nearest = nearest_depth<kDepth>(t, e1, e2);
-                    const float farthest = farthest_[__builtin_ctz(m)];
-                    if (!(kDepth == DepthFunc::greater ? nearest <= farthest : nearest >= farthest)) continue;
+                    if (!behind<kDepth>(nearest_depth<kDepth>(t, e1, e2), farthest_[__builtin_ctz(m)])) continue;
                     ++out.depth_rejected;
                     if (coverage == BlockCoverage::some) {
                         out.hidden |= m;
@@ -282,13 +285,13 @@ private:
             const std::uint32_t blocks = blocks_in(target_.x0, target_.y0, target_.x1, target_.y1);
             constexpr bool kGreater = kDepth == DepthFunc::greater;
             const float nearest = nearest_depth<kDepth>(t, r);
-            if (!(kGreater ? nearest <= target_farthest_ : nearest >= target_farthest_)) {
+            if (!behind<kDepth>(nearest, target_farthest_)) {
                 constexpr float kInfinity = std::numeric_limits<float>::infinity();
                 float farthest_of_all = kGreater ? kInfinity : -kInfinity;
                 for (std::uint32_t m = blocks; m; m &= m - 1) {  // hidden behind every block's farthest depth
                     known_farthest<kDepth>(m & -m);
                     const float farthest = farthest_[__builtin_ctz(m)];
-                    if (!(kGreater ? nearest <= farthest : nearest >= farthest)) return false;
+                    if (!behind<kDepth>(nearest, farthest)) return false;
                     farthest_of_all =
                         kGreater ? std::min(farthest_of_all, farthest) : std::max(farthest_of_all, farthest);
                 }
