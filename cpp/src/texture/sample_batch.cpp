@@ -106,12 +106,16 @@ template <typename T, typename V>
     std::memcpy(p, &x, sizeof x);
 }
 
+static_assert(kMaxTextureBytes / sizeof(float) <= std::uint64_t{1} << 31, "a level's floats outgrow an int32 index");
+
 // Per lane, what the blend needs: which level(s), the weight of the finer one's neighbour,
 // the texel indices of the bilinear quads and their fractions.
 struct LanePlan {
     std::int32_t level[kLookupBatch];
     float level_weight[kLookupBatch];  // > 0: blend towards level + 1
-    std::int32_t texel[2][4][kLookupBatch];  // per level: the quad's texels a b / c d
+    // Per level: where the quad's texels a b / c d start, in floats from the level's first (four
+    // per texel, so the loads need no shift; a level of at most kMaxTextureBytes keeps it an int32).
+    std::int32_t texel_float[2][4][kLookupBatch];
     float fx[2][kLookupBatch], fy[2][kLookupBatch];
     std::int32_t finite[kLookupBatch];  // 0: the lane is sample_texture's (−1: all inputs finite)
 };
@@ -251,13 +255,14 @@ template <int W, bool kPowerOfTwo>
         Floats fx, fy;
         axis<W, kPowerOfTwo>(u, wk, wk_int, s.wrap_u, i0, i1, fx);
         axis<W, kPowerOfTwo>(v, hk, hk_int, s.wrap_v, j0, j1, fy);
-        const Ints row0 = j0 * wk_int, row1 = j1 * wk_int;
+        const Ints row_floats = wk_int << 2, row0 = j0 * row_floats, row1 = j1 * row_floats;
+        i0 <<= 2, i1 <<= 2;
         // (Four stores, not a loop over an array of vectors: GCC copied such an array through the
         // stack in halves, and the reloads waited on the wide stores.)
-        store_v(plan.texel[step][0] + first, row0 + i0);
-        store_v(plan.texel[step][1] + first, row0 + i1);
-        store_v(plan.texel[step][2] + first, row1 + i0);
-        store_v(plan.texel[step][3] + first, row1 + i1);
+        store_v(plan.texel_float[step][0] + first, row0 + i0);
+        store_v(plan.texel_float[step][1] + first, row0 + i1);
+        store_v(plan.texel_float[step][2] + first, row1 + i0);
+        store_v(plan.texel_float[step][3] + first, row1 + i1);
         store_v(plan.fx[step] + first, fx);
         store_v(plan.fy[step] + first, fy);
     }
@@ -525,13 +530,13 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     // the finer level are asked for first, so that the misses overlap instead of each lane
     // waiting for its own. (The coarser level has a quarter of the lines, mostly in cache; asking
     // for them too, or on four rows' spread only, saved less in the cube.)
-    if (!only_lines && n > 1 && std::abs(std::int64_t{plan.texel[0][0][n - 1]} - plan.texel[0][0][0]) >
-                     std::max(1, texture_.width() >> plan.level[0])) {
+    if (!only_lines && n > 1 && std::abs(std::int64_t{plan.texel_float[0][0][n - 1]} - plan.texel_float[0][0][0]) >
+                     4 * std::max(1, texture_.width() >> plan.level[0])) {
         for (int l = 0; l < n; ++l) {
             if (!plan.finite[l] || (some_lines && lines.count[l] > 1)) continue;
-            const glm::vec4* t = level(plan.level[l]);
-            __builtin_prefetch(t + plan.texel[0][0][l]);
-            __builtin_prefetch(t + plan.texel[0][2][l]);
+            const float* t = level_floats(plan.level[l]);
+            __builtin_prefetch(t + plan.texel_float[0][0][l]);
+            __builtin_prefetch(t + plan.texel_float[0][2][l]);
         }
     }
     // The lines of all the batch's lanes that take them, at once (lane l's is line_of[l]).
@@ -565,17 +570,17 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
             continue;
         }
         const auto quad = [&](int step) {
-            const glm::vec4* t = level(plan.level[l] + step);
-            const std::int32_t(&q)[4][kLookupBatch] = plan.texel[step];
-            return lerp_quad(load(t[q[0][l]]), load(t[q[1][l]]), load(t[q[2][l]]), load(t[q[3][l]]), plan.fx[step][l],
-                             plan.fy[step][l]);
+            const float* t = level_floats(plan.level[l] + step);
+            const std::int32_t(&q)[4][kLookupBatch] = plan.texel_float[step];
+            return lerp_quad(load(t + q[0][l]), load(t + q[1][l]), load(t + q[2][l]), load(t + q[3][l]),
+                             plan.fx[step][l], plan.fy[step][l]);
         };
         Texel c;
         if (plan.level_weight[l] > 0.0f) {
 #if defined(__AVX__)  // both levels' quads side by side: the same operations per half
-            const glm::vec4 *finer = level(plan.level[l]), *coarser = level(plan.level[l] + 1);
+            const float *finer = level_floats(plan.level[l]), *coarser = level_floats(plan.level[l] + 1);
             const auto corner = [&](int k) {
-                return load_pair(finer[plan.texel[0][k][l]], coarser[plan.texel[1][k][l]]);
+                return load_pair(finer + plan.texel_float[0][k][l], coarser + plan.texel_float[1][k][l]);
             };
             const TexelPair top = lerp_pair(corner(0), corner(1), plan.fx[0][l], plan.fx[1][l]);
             const TexelPair bottom = lerp_pair(corner(2), corner(3), plan.fx[0][l], plan.fx[1][l]);

@@ -19,6 +19,11 @@ inline Texel load(const glm::vec4& t) {
     std::memcpy(&r, &t, sizeof r);
     return r;
 }
+inline Texel load(const float* rgba) {
+    Texel r;
+    std::memcpy(&r, rgba, sizeof r);
+    return r;
+}
 inline glm::vec4 to_vec4(Texel t) {
     glm::vec4 r;
     std::memcpy(&r, &t, sizeof r);
@@ -41,8 +46,8 @@ typedef float TexelPair __attribute__((vector_size(32)));
 
 // (Intrinsics: two 16-byte copies into a 32-byte variable were read back through memory, and the
 // wide load waited for the narrow stores, doubling the frame.)
-inline TexelPair load_pair(const glm::vec4& finer, const glm::vec4& coarser) {
-    const __m128 low = _mm_loadu_ps(&finer.x), high = _mm_loadu_ps(&coarser.x);
+inline TexelPair load_pair(const float* finer, const float* coarser) {
+    const __m128 low = _mm_loadu_ps(finer), high = _mm_loadu_ps(coarser);
     return TexelPair(_mm256_insertf128_ps(_mm256_castps128_ps256(low), high, 1));
 }
 inline Texel finer_half(TexelPair p) { return Texel(_mm256_castps256_ps128(__m256(p))); }

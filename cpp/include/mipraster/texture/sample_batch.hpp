@@ -87,6 +87,7 @@ private:
     const glm::vec4* level_texels_[32] = {};
     const glm::vec4* level(int k) { return level_texels_[k] ? level_texels_[k] : first_use(k); }
     const glm::vec4* first_use(int k);
+    const float* level_floats(int k) { return &level(k)->x; }  // (the texels' floats, RGBA by RGBA)
 };
 
 }  // namespace mipraster
