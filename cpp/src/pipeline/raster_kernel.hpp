@@ -744,36 +744,41 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
         edges_at(px, py, s, e);
         shade_sample(px, py, s, screen_weights(*ref.triangle, e[0], e[1], e[2]));
     };
-    if (S == 1) {
-        // Runs of pixels with one owner, their weights a row at a time (sample_row.hpp).
+    if (!target.owner_shade_at) {
+        // One sample or SSAA, every sample shaded on its own: along each row, runs of pixels whose
+        // sample s has one owner, their weights a row at a time (sample_row.hpp). (Replace blending
+        // writes each sample once, so the order of the samples does not matter.)
         double l0[kTileSize], l1[kTileSize], l2[kTileSize];
-        for (int py = target.y0; py < target.y1; ++py) {
-            const std::int32_t* const row = &target.owners[target.owner_index(target.x0, py, 0, 1)] - target.x0;
-            for (int px = target.x0, end; px < target.x1; px = end) {
-                const std::int32_t owner = row[px];
-                for (end = px + 1; end < target.x1 && row[end] == owner;) ++end;
-                if (owner < 0 || !take(owner)) continue;
-                std::int64_t e[3];
-                edges_at(px, py, 0, e);
-                if (end - px >= kSampleRowMinPixels && sample_row_weights(*ref.triangle, e, end - px, l0, l1, l2)) {
+        for (int py = target.y0; py < target.y1; ++py)
+            for (int s = 0; s < S; ++s) {
+                const std::int32_t* const row = &target.owners[target.owner_index(target.x0, py, s, S)];
+                const auto owner_of = [&](int px) { return row[static_cast<std::size_t>(px - target.x0) * S]; };
+                for (int px = target.x0, end; px < target.x1; px = end) {
+                    const std::int32_t owner = owner_of(px);
+                    for (end = px + 1; end < target.x1 && owner_of(end) == owner;) ++end;
+                    if (owner < 0 || !take(owner)) continue;
+                    std::int64_t e[3];
+                    edges_at(px, py, s, e);
                     const int n = end - px;
+                    if (n < kSampleRowMinPixels || !sample_row_weights(*ref.triangle, e, n, l0, l1, l2)) {
+                        for (int x = px; x < end; ++x) shade_exactly(x, py, s);
+                        continue;
+                    }
                     const std::uint32_t run = ~std::uint32_t{0} >> (32 - n);
+                    float* const first = target.color.at(px, py, s);
                     if (queue) {  // the run as one mask
                         counters.shader_invocations += static_cast<std::uint64_t>(n);
-                        queue->push_row(target.color.at(px, py, 0), 4, run, l0, l1, l2, px, py);
+                        queue->push_row(first, 4 * S, run, l0, l1, l2, px, py);
                     } else if (kColoursByRow<kShading, kTexturing> && ref.triangle->clip_index < 0) {
                         counters.shader_invocations += static_cast<std::uint64_t>(n);
-                        shade_row_colours<BlendMode::replace>(target.color.at(px, py, 0), 4, run, l0, l1, l2, draw,
-                                                              run_shading, colors, *ref.triangle);
+                        shade_row_colours<BlendMode::replace>(first, 4 * S, run, l0, l1, l2, draw, run_shading, colors,
+                                                              *ref.triangle);
                     } else {
-                        for (int j = 0; j < n; ++j) shade_sample(px + j, py, 0, glm::dvec3(l0[j], l1[j], l2[j]));
+                        for (int j = 0; j < n; ++j) shade_sample(px + j, py, s, glm::dvec3(l0[j], l1[j], l2[j]));
                     }
-                } else {
-                    for (int x = px; x < end; ++x) shade_exactly(x, py, 0);
                 }
             }
-        }
-    } else if (target.owner_shade_at) {
+    } else {
         // MSAA: the samples of a pixel with one owner, shaded once where the owner's draw shaded the
         // pixel (its centre, or a sample) and stored to all of them, as that draw did.
         const std::uint64_t all = S == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << S) - 1;
@@ -839,13 +844,6 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
                 }
                 px = end;
             }
-    } else {
-        for (int py = target.y0; py < target.y1; ++py)
-            for (int px = target.x0; px < target.x1; ++px)
-                for (int s = 0; s < S; ++s) {
-                    const std::int32_t owner = target.owners[target.owner_index(px, py, s, S)];
-                    if (owner >= 0 && take(owner)) shade_exactly(px, py, s);
-                }
     }
     if (queue) queue->flush();
 }
