@@ -130,6 +130,10 @@ public:
             const Pending& p = pending_[i];
             glm::vec4 c = colour[i];
             c *= texture[i];  // as shade() multiplies
+            if (p.samples == 1) {  // (one sample per pixel, or SSAA: the slot itself)
+                blend_into<kBlend>(p.target, c);
+                continue;
+            }
             for (std::uint64_t m = p.samples; m; m &= m - 1) blend_into<kBlend>(p.target + 4 * __builtin_ctzll(m), c);
         }
         count_ = 0;
