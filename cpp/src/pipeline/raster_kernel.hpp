@@ -464,10 +464,21 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             return true;
         };
 
+        // Deferred shading's MSAA pre-pass: samples `passed` of pixel (px, py) name this triangle
+        // their owner, with where it would shade the pixel (shade_owned shades there).
+        const auto record_owner = [&](int px, int py, std::uint64_t passed, bool at_centre) {
+            const std::size_t first = target.owner_index(px, py, 0, S);
+            const auto at = static_cast<std::uint8_t>(at_centre ? kShadeAtCentre : __builtin_ctzll(passed));
+            for (std::uint64_t m = passed; m; m &= m - 1) {
+                target.owners[first + __builtin_ctzll(m)] = owner;
+                target.owner_shade_at[first + __builtin_ctzll(m)] = at;
+            }
+        };
+
         // A long MSAA row of pixels rx0 … rx0 + n − 1 whose first pixel's corner has edge values
         // `corner`, where sample_rows_exact holds and no block is skipped or hidden. Each pixel is
-        // shaded once, at its centre when that is inside the triangle, else at its first sample
-        // that passed.
+        // shaded once (or, in the pre-pass, its owner recorded), at its centre when that is inside
+        // the triangle, else at its first sample that passed.
         const auto msaa_row = [&](int rx0, int py, int n, const std::int64_t (&corner)[3]) {
             std::uint64_t samples[kTileSize];  // per pixel, the samples that passed
             const double* const offsets[3] = {offset0, offset1, offset2};
@@ -480,8 +491,16 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
             if (!pixels) return;
             blocks.written_row(py, rx0, pixels);
-            counters.shader_invocations += static_cast<std::uint64_t>(count_bits(pixels));
             const std::int64_t centre[3] = {corner[0] + to_centre0, corner[1] + to_centre1, corner[2] + to_centre2};
+            if constexpr (kShading == Shading::visibility) {
+                for (std::uint32_t m = pixels; m; m &= m - 1) {
+                    const int j = __builtin_ctz(m);
+                    record_owner(rx0 + j, py, samples[j],
+                                 ((centre[0] + j * step0) | (centre[1] + j * step1) | (centre[2] + j * step2)) >= 0);
+                }
+                return;
+            }
+            counters.shader_invocations += static_cast<std::uint64_t>(count_bits(pixels));
             double l0[kTileSize], l1[kTileSize], l2[kTileSize];
             sample_row_weights(t, centre, n, l0, l1, l2);  // (exact: the centres lie within the row's pixels)
             for (std::uint32_t m = pixels; m; m &= m - 1) {
@@ -537,13 +556,15 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 }
             }
 
-            // MSAA, depth tested, textured: a long row's pixels tested one after the other, four
-            // samples per vector, then shaded into the lookup queue at once (their centres' weights
-            // a row at a time): the per-pixel path's values and order (plane MSAA 4x −8 %). Not
-            // where a block is hidden: its pixels skip their tests one by one at less cost
-            // (overdraw MSAA 4x was 7 % slower).
-            if constexpr (kMode == SampleMode::msaa && kDepth != DepthFunc::none && kTexturing != Texturing::none) {
-                if (queue && pixel_vectors && n >= kSampleRowMinPixels && !blocks.row_pixels(classified, py, rx0, n) &&
+            // MSAA, depth tested, textured (or the pre-pass of textured draws): a long row's pixels
+            // tested one after the other, four samples per vector, then shaded into the lookup queue
+            // at once (their centres' weights a row at a time), or their owners recorded: the
+            // per-pixel path's values and order (plane MSAA 4x −8 %). Not where a block is hidden:
+            // its pixels skip their tests one by one at less cost (overdraw MSAA 4x was 7 % slower).
+            if constexpr (kMode == SampleMode::msaa && kDepth != DepthFunc::none &&
+                          (kTexturing != Texturing::none || kShading == Shading::visibility)) {
+                const bool rows_go = kShading == Shading::visibility ? target.owners != nullptr : queue.has_value();
+                if (rows_go && pixel_vectors && n >= kSampleRowMinPixels && !blocks.row_pixels(classified, py, rx0, n) &&
                     sample_rows_exact(t, {row0, row1, row2}, n)) {
                     msaa_row(rx0, py, n, {row0, row1, row2});
                     continue;
@@ -624,14 +645,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     counters.samples_passed += static_cast<std::uint64_t>(count_bits(passed));
                     const bool at_centre = ((p0 + to_centre0) | (p1 + to_centre1) | (p2 + to_centre2)) >= 0;
                     if constexpr (kShading == Shading::visibility) {
-                        // Deferred shading's pre-pass: the samples' owner, and where it would shade
-                        // the pixel (shade_owned shades there, the shade below).
-                        const std::size_t first = target.owner_index(px, py, 0, S);
-                        const auto at = static_cast<std::uint8_t>(at_centre ? kShadeAtCentre : __builtin_ctzll(passed));
-                        for (std::uint64_t m = passed; m; m &= m - 1) {
-                            target.owners[first + __builtin_ctzll(m)] = owner;
-                            target.owner_shade_at[first + __builtin_ctzll(m)] = at;
-                        }
+                        record_owner(px, py, passed, at_centre);  // (the shade below, deferred)
                     } else {
                         ++counters.shader_invocations;
                         glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
