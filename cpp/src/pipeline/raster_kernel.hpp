@@ -824,12 +824,24 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
         };
         // Runs of pixels whose samples all have one owner that shades them at their centres go to
         // the lookup queue a row at a time, their weights as the forward kernel's long rows take them.
-        const auto whole_at_centre = [&](int px, int py, std::int32_t owner) {
+        // Such a run from pixel px on ends where a sample's owner or place differs: a scan of the
+        // row's samples, four at a time (a sample at a time, this scan was two thirds of the pass).
+        const auto centre_run_end = [&](int px, int py, std::int32_t owner) {
             const std::size_t first = target.owner_index(px, py, 0, S);
-            for (int s = 0; s < S; ++s)
-                if (target.owners[first + s] != owner || target.owner_shade_at[first + s] != kShadeAtCentre)
-                    return false;
-            return true;
+            const std::size_t count = static_cast<std::size_t>(target.x1 - px) * static_cast<std::size_t>(S);
+            const std::int32_t* const owners = target.owners + first;
+            const std::uint8_t* const places = target.owner_shade_at + first;
+            static_assert(kShadeAtCentre == 0xff, "four places at the centre are an all-ones word");
+            std::size_t k = 0;
+            for (; k + 4 <= count; k += 4) {
+                std::uint32_t four_places;
+                std::memcpy(&four_places, places + k, sizeof four_places);
+                if ((four_places + 1) | (owners[k] ^ owner) | (owners[k + 1] ^ owner) | (owners[k + 2] ^ owner) |
+                    (owners[k + 3] ^ owner))
+                    break;
+            }
+            while (k < count && owners[k] == owner && places[k] == kShadeAtCentre) ++k;
+            return px + static_cast<int>(k / static_cast<std::size_t>(S));
         };
         std::uint64_t all_samples[kTileSize];
         std::fill(all_samples, all_samples + kTileSize, all);
@@ -837,9 +849,7 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
         for (int py = target.y0; py < target.y1; ++py)
             for (int px = target.x0; px < target.x1;) {
                 const std::int32_t owner = target.owners[target.owner_index(px, py, 0, S)];
-                int end = px;
-                if (queue && owner >= 0)
-                    while (end < target.x1 && whole_at_centre(end, py, owner)) ++end;
+                const int end = queue && owner >= 0 ? centre_run_end(px, py, owner) : px;
                 if (end - px < kSampleRowMinPixels) {
                     shade_pixel(px++, py);
                     continue;
