@@ -197,7 +197,7 @@ def render(scene: Scene, camera: Camera, width: int, height: int, spp: int = 1, 
             a quarter of the render's samples; 0 = no probe (the raw halves estimate; needs
             ``spp >= 2``).
         deferred_shading: where a tile's triangles overlap 1.25 or more deep (without a texture,
-            deeper the smaller its triangles; under MSAA 3 or more deep, textured draws only) and
+            deeper the smaller its triangles; under MSAA 1.5 or more deep, textured draws only) and
             each of them replaces what lies beneath without an alpha test, find each sample's
             visible triangle first and shade it once (MSAA: once per pixel and visible triangle)
             (``stats["tiles_deferred"]`` counts those tiles). The image is the same bit for bit;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "helpers.hpp"
+#include "mipraster/core/constants.hpp"
 #include "mipraster/pipeline/binning.hpp"
 #include "mipraster/pipeline/triangle_setup.hpp"
 
@@ -192,13 +193,16 @@ TEST(DeferredShading, UntexturedTilesAreDeferredOnlyWithBigEnoughTriangles) {
 
 // `layers` textured quads over the whole W × H viewport (positions in 1/256 px: fixed_to_ndc), each
 // nearer than the one before: every tile's overdraw is `layers`.
-mr::Mesh layered_quads(int layers, int W, int H) {
+// `layers` textured quads over a W × H viewport (fixed_to_ndc), drawn back to front; the last one
+// only over x < last_width · W.
+mr::Mesh layered_quads(int layers, int W, int H, float last_width = 1.0f) {
     mr::Mesh m;
     for (int k = 0; k < layers; ++k) {
         const float z = 0.8f - 0.3f * static_cast<float>(k);  // (OpenGL depth: nearer is smaller)
+        const float width = k == layers - 1 ? last_width : 1.0f;
         const auto first = static_cast<std::uint32_t>(m.positions.size());
         for (const glm::vec2 corner : {glm::vec2(0, 0), glm::vec2(1, 0), glm::vec2(1, 1), glm::vec2(0, 1)}) {
-            m.positions.push_back({corner.x * W * 256.0f, corner.y * H * 256.0f, z});
+            m.positions.push_back({corner.x * width * W * 256.0f, corner.y * H * 256.0f, z});
             m.uvs.push_back(corner * (1.5f + static_cast<float>(k)));
         }
         add_triangle(m, first, first + 1, first + 2);
@@ -207,28 +211,32 @@ mr::Mesh layered_quads(int layers, int W, int H) {
     return m;
 }
 
-// Overdraw 2 defers tiles at one sample and under SSAA, not under MSAA (kDeferredMinOverdrawMsaa:
-// 3); overdraw 4 defers them under MSAA too, with the forward image.
+// Over a 2 × 2 tile viewport, a full quad and one over 70 % of the width: overdraw 2 in the left
+// tiles, 1.4 in the right ones. One sample and SSAA defer all four (from 1.25), MSAA the left two
+// (from kDeferredMinOverdrawMsaa = 1.5); four full quads all four under MSAA too. The forward image
+// every time.
 TEST(DeferredShading, MsaaTilesAreDeferredFromADeeperOverdraw) {
+    static_assert(mr::kDeferredMinOverdraw < 1.4 && mr::kDeferredMinOverdrawMsaa > 1.4 &&
+                  mr::kDeferredMinOverdrawMsaa <= 2.0, "the cases below straddle the thresholds");
     const int W = 64, H = 64;
-    for (const auto& [layers, aa, samples, deferred] :
-         {std::tuple{2, mr::AntiAliasing::ssaa, 1, true}, std::tuple{2, mr::AntiAliasing::ssaa, 4, true},
-          std::tuple{2, mr::AntiAliasing::msaa, 4, false}, std::tuple{4, mr::AntiAliasing::msaa, 4, true}}) {
+    for (const auto& [layers, aa, samples, deferred_tiles] :
+         {std::tuple{2, mr::AntiAliasing::ssaa, 1, 4u}, std::tuple{2, mr::AntiAliasing::ssaa, 4, 4u},
+          std::tuple{2, mr::AntiAliasing::msaa, 4, 2u}, std::tuple{4, mr::AntiAliasing::msaa, 4, 4u}}) {
         SCOPED_TRACE(std::to_string(layers) + " layers, " + mr::to_string(aa) + " " + std::to_string(samples));
-        const mr::Mesh quads = layered_quads(layers, W, H);
+        const mr::Mesh quads = layered_quads(layers, W, H, layers == 2 ? 0.7f : 1.0f);
         mr::Draw draw = make_draw(quads, fixed_to_ndc(W, H), {});
         draw.texture = checker_texture();
         auto s = settings(W, H, samples);
         s.anti_aliasing = aa;
         const Outcome o = render_both({draw}, identity_camera(), s);
         expect_same_image(o);
-        EXPECT_EQ(o.deferred.stats.tiles_deferred, deferred ? 4u : 0u);
-        // Deferred: one shade per sample, the nearest layer's; under MSAA one per pixel, and two
+        EXPECT_EQ(o.deferred.stats.tiles_deferred, deferred_tiles);
+        EXPECT_LT(o.deferred.stats.shader_invocations, o.forward.stats.shader_invocations);
+        // All deferred: one shade per sample, the nearest layer's; under MSAA one per pixel, and two
         // where the diagonal between the nearest quad's triangles splits a pixel's samples.
         const std::uint64_t shades = o.deferred.stats.shader_invocations, pixels = std::uint64_t(W) * H;
-        if (!deferred) {
-            EXPECT_EQ(shades, o.forward.stats.shader_invocations);
-        } else if (aa == mr::AntiAliasing::msaa) {
+        if (deferred_tiles < 4) continue;
+        if (aa == mr::AntiAliasing::msaa) {
             EXPECT_GE(shades, pixels);
             EXPECT_LE(shades, pixels + 2 * W);
             EXPECT_GT(o.forward.stats.shader_invocations, 3 * pixels);
