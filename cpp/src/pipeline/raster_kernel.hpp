@@ -563,9 +563,9 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             // its pixels skip their tests one by one at less cost (overdraw MSAA 4x was 7 % slower).
             if constexpr (kMode == SampleMode::msaa && kDepth != DepthFunc::none &&
                           (kTexturing != Texturing::none || kShading == Shading::visibility)) {
-                const bool rows_go = kShading == Shading::visibility ? target.owners != nullptr : queue.has_value();
-                if (rows_go && pixel_vectors && n >= kSampleRowMinPixels && !blocks.row_pixels(classified, py, rx0, n) &&
-                    sample_rows_exact(t, {row0, row1, row2}, n)) {
+                const bool takes_rows = kShading == Shading::visibility ? target.owners != nullptr : queue.has_value();
+                if (takes_rows && pixel_vectors && n >= kSampleRowMinPixels &&
+                    !blocks.row_pixels(classified, py, rx0, n) && sample_rows_exact(t, {row0, row1, row2}, n)) {
                     msaa_row(rx0, py, n, {row0, row1, row2});
                     continue;
                 }
