@@ -191,10 +191,8 @@ TEST(DeferredShading, UntexturedTilesAreDeferredOnlyWithBigEnoughTriangles) {
     }
 }
 
-// `layers` textured quads over the whole W × H viewport (positions in 1/256 px: fixed_to_ndc), each
-// nearer than the one before: every tile's overdraw is `layers`.
-// `layers` textured quads over a W × H viewport (fixed_to_ndc), drawn back to front; the last one
-// only over x < last_width · W.
+// `layers` textured quads over the W × H viewport (positions in 1/256 px: fixed_to_ndc), each nearer
+// than the one before, the last one only over x < last_width · W.
 mr::Mesh layered_quads(int layers, int W, int H, float last_width = 1.0f) {
     mr::Mesh m;
     for (int k = 0; k < layers; ++k) {

@@ -109,7 +109,7 @@ template <typename T, typename V>
 static_assert(kMaxTextureBytes / sizeof(float) <= std::uint64_t{1} << 31, "a level's floats outgrow an int32 index");
 
 // Per lane, what the blend needs: which level(s), the weight of the finer one's neighbour,
-// the texel indices of the bilinear quads and their fractions.
+// where the texels of the bilinear quads lie and their fractions.
 struct LanePlan {
     std::int32_t level[kLookupBatch];
     float level_weight[kLookupBatch];  // > 0: blend towards level + 1
