@@ -214,8 +214,8 @@ TEST(BatchedLookups, BatchedInterpolationGivesTheReferenceBits) {
                                 s.deferred_shading = deferred;
                                 const Outcome o = render_both(draws, *cam, s);
                                 expect_same_geometry(o);
-                                // (MSAA is never deferred)
-                                EXPECT_EQ(o.batched.stats.tiles_deferred > 0, deferred && aa != mr::AntiAliasing::msaa);
+                                // (The overlap, about 2.5 deep, is deferred under MSAA too: textured.)
+                                EXPECT_EQ(o.batched.stats.tiles_deferred > 0, deferred);
                                 EXPECT_TRUE(same_bits(o.batched.framebuffer.color, o.reference.framebuffer.color));
                             }
     }
