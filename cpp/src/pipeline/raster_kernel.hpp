@@ -741,11 +741,13 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
         return true;
     };
     // The current triangle's edge values at sample s of pixel (px, py).
-    const auto edges_at = [&](int px, int py, int s, std::int64_t (&e)[3]) {
-        const SetupTriangle& t = *ref.triangle;
-        const std::int64_t X = std::int64_t{px} * kSubpixelOne + pattern.x[s];
-        const std::int64_t Y = std::int64_t{py} * kSubpixelOne + pattern.y[s];
+    const auto edges_within = [&](int px, int py, std::int64_t ox, std::int64_t oy, std::int64_t (&e)[3]) {
+        const SetupTriangle& t = *ref.triangle;  // (at (ox, oy), in 1/256 px, from the pixel's corner)
+        const std::int64_t X = std::int64_t{px} * kSubpixelOne + ox, Y = std::int64_t{py} * kSubpixelOne + oy;
         for (int i = 0; i < 3; ++i) e[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+    };
+    const auto edges_at = [&](int px, int py, int s, std::int64_t (&e)[3]) {
+        edges_within(px, py, pattern.x[s], pattern.y[s], e);
     };
     const auto shade_sample = [&](int px, int py, int s, const glm::dvec3& l) __attribute__((always_inline)) {
         ++counters.shader_invocations;
@@ -797,10 +799,7 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
         // pixel (its centre, or a sample) and stored to all of them, as that draw did.
         const std::uint64_t all = S == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << S) - 1;
         const auto centre_edges = [&](int px, int py, std::int64_t (&e)[3]) {
-            const SetupTriangle& t = *ref.triangle;
-            const std::int64_t X = std::int64_t{px} * kSubpixelOne + kSubpixelOne / 2;
-            const std::int64_t Y = std::int64_t{py} * kSubpixelOne + kSubpixelOne / 2;
-            for (int i = 0; i < 3; ++i) e[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+            edges_within(px, py, kSubpixelOne / 2, kSubpixelOne / 2, e);
         };
         const auto shade_pixel = [&](int px, int py) {
             const std::size_t first = target.owner_index(px, py, 0, S);

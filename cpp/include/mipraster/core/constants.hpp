@@ -41,10 +41,11 @@ inline constexpr double kDeferredMinOverdraw = 1.25;
 static_assert(kDeferredMinOverdraw >= 1.0, "deferring pays only where triangles overlap");
 /// The same under MSAA, which shades a pixel once per triangle already while its pre-pass tests
 /// and records every sample. Measured (README, "Session 34"; 1080p layers of textured quads, one
-/// thread): drawn back to front, deferring breaks even at an overdraw of about 1.3 and saves 12 % at
-/// 2, 30 % at 4; front to back it costs 6 % without overlap and 16–24 % from 1.5 (forward, a hidden
-/// layer costs little); in an unsorted order the layers shaded per pixel grow as the harmonic
-/// number, which puts the break-even near 1.5. The benchmark's cube (about 1.5) is 4 % faster deferred.
+/// thread): drawn back to front, deferring breaks even at an overdraw of about 1.3 and saves 12 %
+/// at 2, 30 % at 4; front to back it costs 6 % without overlap and 16–24 % from 1.5 (a hidden layer
+/// costs the pre-pass about 8 ms, the forward kernel about 3.5); in an unsorted order the layers
+/// shaded per pixel grow as the harmonic number, which puts the break-even near 1.5. The
+/// benchmark's cube (about 1.5) is 4 % faster deferred.
 inline constexpr double kDeferredMinOverdrawMsaa = 1.5;
 static_assert(kDeferredMinOverdrawMsaa >= kDeferredMinOverdraw, "MSAA gains less from deferring");
 /// Untextured shading is cheap, so a tile without textures is deferred only where its overdraw O
