@@ -60,7 +60,8 @@ void anisotropic_line_means(const LineLanes& lanes, const Sampler& sampler, texe
 
 /// anisotropic_line_means' bits with AVX2 (anisotropic_line_avx2.cpp), for repeat and clamp: the
 /// lines placed four lanes per vector, probe k of four lines in one vector, a lookup's two lines
-/// summed in the two halves of one register. Only on a CPU with AVX2.
+/// summed in the two halves of one register (lines of more than 16 probes, from a max_anisotropy
+/// above 16, one lane at a time). Only on a CPU with AVX2.
 void anisotropic_line_means_avx2(const LineLanes& lanes, const Sampler& sampler, texel::Texel* mean_finer,
                                  texel::Texel* mean_coarser);
 

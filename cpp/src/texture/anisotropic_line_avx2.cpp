@@ -10,6 +10,8 @@
 // then their sums. One lane at a time, each step waited for the one before it (a division,
 // roundings, conversions, stores and loads), and a lane's work was too long for the CPU to
 // overlap it with the next lane's; a short line also left most of its probe vector unused.
+// Lines of more than kMostVectorProbes probes (a max_anisotropy above 16) take the reference: a
+// whole line's probes are placed at once, and each lane's sum stays in registers.
 #include <immintrin.h>
 
 #include <algorithm>
@@ -17,6 +19,7 @@
 #include <limits>
 
 #include "anisotropic_line.hpp"
+#include "mipraster/texture/texture.hpp"
 
 namespace mipraster {
 
@@ -26,7 +29,10 @@ using namespace texel;
 
 namespace {
 
-constexpr int kChunk = 16;  // probes of each line placed at a time
+constexpr int kMostVectorProbes = 16;  // the longest line the vectors take
+
+// A level's texels' positions in floats fit an int32 (the vectors' are).
+static_assert(kMaxTextureBytes / sizeof(float) <= std::uint64_t{1} << 31, "a level's floats outgrow an int32 index");
 
 // wrap_index for repeat or clamp of four indices within ±(kProbeReach + 1), on levels of `size`
 // texels (per element). Repeat: powers of two mask (two's complement); other sizes subtract
@@ -102,33 +108,39 @@ struct FourLines {
     return f;
 }
 
-// Probes k0 … k0 + n − 1 of four lines: the quads' texels (indices into each line's level; only
-// corner 0 where the lines lie inside their levels) and fractions, [corner][probe][line]. Lines
-// shorter than k0 + n get probes past their end (unread).
+// Probe c of four lines: its quads' texels (where they start, in floats from each line's level's
+// first: four per texel, so that a load needs no shift; only corner 0 where the lines lie inside
+// their levels), [corner][line], and fractions, [line].
+struct ProbeSlot {
+    std::int32_t texel_float[4][4];
+    float fx[4], fy[4];
+};
+// Probes 0 … n − 1 of four lines (lines shorter than n get probes past their end, unread).
 struct FourProbes {
-    std::int32_t texel[4][kChunk][4];
-    float fx[kChunk][4], fy[kChunk][4];
+    ProbeSlot at[kMostVectorProbes];
 };
 
 // `inside`: the lines whose probes are read all lie inside their levels; then only a quad's first
 // texel is placed, ⌊y⌋·width + ⌊x⌋ in double (exact: below the level's texel count, which fits an
 // int); else all four, their indices wrapped.
-[[gnu::target("avx2")]] void place_probes(const FourLines& f, bool inside, __m256d step, int k0, int n,
-                                          const Sampler& s, FourProbes& p) {
+[[gnu::target("avx2")]] void place_probes(const FourLines& f, bool inside, __m256d step, int n, const Sampler& s,
+                                          FourProbes& p) {
     const __m256d width = _mm256_cvtepi32_pd(f.width);
     const __m128i one = _mm_set1_epi32(1);
     for (int c = 0; c < n; ++c) {
-        const __m256d t = _mm256_mul_pd(_mm256_set1_pd(k0 + c), step);
+        ProbeSlot& at = p.at[c];
+        const __m256d t = _mm256_mul_pd(_mm256_set1_pd(c), step);
         const __m256d x = _mm256_add_pd(f.x0, _mm256_mul_pd(t, f.sx));
         const __m256d y = _mm256_add_pd(f.y0, _mm256_mul_pd(t, f.sy));
         const __m256d fx = _mm256_floor_pd(x), fy = _mm256_floor_pd(y);
-        _mm_storeu_ps(p.fx[c], _mm256_cvtpd_ps(_mm256_sub_pd(x, fx)));
-        _mm_storeu_ps(p.fy[c], _mm256_cvtpd_ps(_mm256_sub_pd(y, fy)));
+        _mm_storeu_ps(at.fx, _mm256_cvtpd_ps(_mm256_sub_pd(x, fx)));
+        _mm_storeu_ps(at.fy, _mm256_cvtpd_ps(_mm256_sub_pd(y, fy)));
         // Past a line's end, or on a line the reference takes, a value may exceed the int range:
-        // the conversion gives INT_MIN there (and the sums below wrap around, defined; unread).
+        // the conversion gives INT_MIN there (and the shifts and sums below wrap around, defined;
+        // unread).
         if (inside) {  // (the other corners follow from the first: see quad)
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[0][c]),
-                             _mm256_cvttpd_epi32(_mm256_add_pd(_mm256_mul_pd(fy, width), fx)));
+            const __m128i texel = _mm256_cvttpd_epi32(_mm256_add_pd(_mm256_mul_pd(fy, width), fx));
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(at.texel_float[0]), _mm_slli_epi32(texel, 2));
             continue;
         }
         const __m128i i0 = _mm256_cvttpd_epi32(fx), j0 = _mm256_cvttpd_epi32(fy);
@@ -140,45 +152,39 @@ struct FourProbes {
         const __m128i texel[4] = {_mm_add_epi32(row0, i), _mm_add_epi32(row0, i1), _mm_add_epi32(row1, i),
                                   _mm_add_epi32(row1, i1)};
         for (int corner = 0; corner < 4; ++corner)
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(p.texel[corner][c]), texel[corner]);
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(at.texel_float[corner]), _mm_slli_epi32(texel[corner], 2));
     }
 }
 
-// Probe c's bilinear quad on line j. kInside: the group's lines lie inside their levels, and only
-// each quad's first texel was placed; the others are the next one and the two below them (`width`
-// texels on).
+// The bilinear quad of probe `at` on line j, on a level whose texels' floats start at t and whose
+// rows are `row` floats long. kInside: the group's lines lie inside their levels, and only each quad's
+// first texel was placed; the others are the next one and the two below them.
 template <bool kInside>
-[[gnu::target("avx2")]] inline Texel quad(const glm::vec4* t, const FourProbes& p, int c, int j, std::ptrdiff_t width) {
+[[gnu::target("avx2")]] inline Texel quad(const float* t, const ProbeSlot& at, int j, std::ptrdiff_t row) {
     if constexpr (kInside) {
-        const glm::vec4* a = t + p.texel[0][c][j];
-        return lerp_quad(load(a[0]), load(a[1]), load(a[width]), load(a[width + 1]), p.fx[c][j], p.fy[c][j]);
+        const float* a = t + at.texel_float[0][j];
+        return lerp_quad(load(a), load(a + 4), load(a + row), load(a + row + 4), at.fx[j], at.fy[j]);
     }
-    return lerp_quad(load(t[p.texel[0][c][j]]), load(t[p.texel[1][c][j]]), load(t[p.texel[2][c][j]]),
-                     load(t[p.texel[3][c][j]]), p.fx[c][j], p.fy[c][j]);
+    return lerp_quad(load(t + at.texel_float[0][j]), load(t + at.texel_float[1][j]), load(t + at.texel_float[2][j]),
+                     load(t + at.texel_float[3][j]), at.fx[j], at.fy[j]);
 }
 
-// A line's running sum, as the reference adds its probes: the first quad, and the differences of
-// the others from it (so that a constant texture gives back its value exactly).
-struct LineSum {
-    Texel first = splat(0.0f), difference = splat(0.0f);
-};
-
-// Adds probes k0 … end − 1 (placed from k0) of line j, on a level `width` texels wide, to `sum`.
+// The mean of line j's probes 0 … count − 1 on a level (floats t, rows `row` floats long), as the
+// reference adds them: the first quad plus the mean difference of the others from it (so that a
+// constant texture gives back its value exactly).
 template <bool kInside>
-[[gnu::target("avx2")]] inline void add_probes(const glm::vec4* t, const FourProbes& p, std::ptrdiff_t width, int j,
-                                               int k0, int end, LineSum& sum) {
-    int k = k0;
-    if (k == 0) {
-        sum.first = quad<kInside>(t, p, 0, j, width);
-        ++k;
-    }
-    for (; k < end; ++k) sum.difference += quad<kInside>(t, p, k - k0, j, width) - sum.first;
+[[gnu::target("avx2")]] inline Texel line_mean(const float* t, const FourProbes& p, std::ptrdiff_t row, int j,
+                                               int count, float step) {
+    const Texel first = quad<kInside>(t, p.at[0], j, row);
+    Texel difference = splat(0.0f);
+    for (int k = 1; k < count; ++k) difference += quad<kInside>(t, p.at[k], j, row) - first;
+    return first + difference * splat(step);
 }
 
 // A texel of each of two levels in one register (the finer level's in the low half), and the
 // blends of texel.hpp on both halves at once: per half the same operations as lerp.
-[[gnu::target("avx2")]] inline __m256 pair(const glm::vec4& finer, const glm::vec4& coarser) {
-    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&finer.x)), _mm_loadu_ps(&coarser.x), 1);
+[[gnu::target("avx2")]] inline __m256 pair(const float* finer, const float* coarser) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(finer)), _mm_loadu_ps(coarser), 1);
 }
 [[gnu::target("avx2")]] inline __m256 lerp_pair(__m256 a, __m256 b, __m256 t) {
     return _mm256_add_ps(a, _mm256_mul_ps(t, _mm256_sub_ps(b, a)));
@@ -187,48 +193,35 @@ template <bool kInside>
     return _mm256_set_m128(_mm_set1_ps(coarser), _mm_set1_ps(finer));
 }
 
-// Probe c's quads on line j of two levels (finer level ta, coarser tb) at once, as quad<kInside>
-// on each.
+// The quads of probe pa and pb on line j of two levels (finer level ta, coarser tb) at once, as
+// quad<kInside> on each.
 template <bool kInside>
-[[gnu::target("avx2")]] inline __m256 quads(const glm::vec4* ta, const FourProbes& pa, std::ptrdiff_t wa,
-                                            const glm::vec4* tb, const FourProbes& pb, std::ptrdiff_t wb, int c,
-                                            int j) {
+[[gnu::target("avx2")]] inline __m256 quads(const float* ta, const ProbeSlot& pa, std::ptrdiff_t ra, const float* tb,
+                                            const ProbeSlot& pb, std::ptrdiff_t rb, int j) {
     __m256 corner[4];
     if constexpr (kInside) {
-        const glm::vec4 *a = ta + pa.texel[0][c][j], *b = tb + pb.texel[0][c][j];
-        corner[0] = pair(a[0], b[0]), corner[1] = pair(a[1], b[1]);
-        corner[2] = pair(a[wa], b[wb]), corner[3] = pair(a[wa + 1], b[wb + 1]);
+        const float *a = ta + pa.texel_float[0][j], *b = tb + pb.texel_float[0][j];
+        corner[0] = pair(a, b), corner[1] = pair(a + 4, b + 4);
+        corner[2] = pair(a + ra, b + rb), corner[3] = pair(a + ra + 4, b + rb + 4);
     } else {
-        for (int k = 0; k < 4; ++k) corner[k] = pair(ta[pa.texel[k][c][j]], tb[pb.texel[k][c][j]]);
+        for (int k = 0; k < 4; ++k) corner[k] = pair(ta + pa.texel_float[k][j], tb + pb.texel_float[k][j]);
     }
-    const __m256 fx = halves(pa.fx[c][j], pb.fx[c][j]);
-    return lerp_pair(lerp_pair(corner[0], corner[1], fx), lerp_pair(corner[2], corner[3], fx),
-                     halves(pa.fy[c][j], pb.fy[c][j]));
+    const __m256 fx = halves(pa.fx[j], pb.fx[j]);
+    return lerp_pair(lerp_pair(corner[0], corner[1], fx), lerp_pair(corner[2], corner[3], fx), halves(pa.fy[j], pb.fy[j]));
 }
 
-// add_probes on two levels at once: each level's sum in its own half of a register, in its probe
-// order (the same bits as one level at a time, half the instructions).
+// line_mean on two levels at once, each level's sum in its own half of a register (the same bits
+// as one level at a time, half the instructions).
 template <bool kInside>
-[[gnu::target("avx2")]] inline void add_probes(const glm::vec4* ta, const FourProbes& pa, std::ptrdiff_t wa,
-                                               const glm::vec4* tb, const FourProbes& pb, std::ptrdiff_t wb, int j,
-                                               int k0, int end, LineSum& a, LineSum& b) {
-    __m256 first = _mm256_set_m128(__m128(b.first), __m128(a.first));
-    __m256 difference = _mm256_set_m128(__m128(b.difference), __m128(a.difference));
-    int k = k0;
-    if (k == 0) {
-        first = quads<kInside>(ta, pa, wa, tb, pb, wb, 0, j);
-        ++k;
-    }
-    for (; k < end; ++k)
-        difference = _mm256_add_ps(difference, _mm256_sub_ps(quads<kInside>(ta, pa, wa, tb, pb, wb, k - k0, j), first));
-    a.first = Texel(_mm256_castps256_ps128(first)), a.difference = Texel(_mm256_castps256_ps128(difference));
-    b.first = Texel(_mm256_extractf128_ps(first, 1)), b.difference = Texel(_mm256_extractf128_ps(difference, 1));
-}
-
-// Whether the vectors take a line on `level` (else the reference does: too far out for int
-// indices, or a level whose texel indices overflow an int).
-bool vectors_reach(bool near, const TextureLevel& level) {
-    return near && level.texels.size() <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+[[gnu::target("avx2")]] inline void line_means(const float* ta, const FourProbes& pa, std::ptrdiff_t ra,
+                                               const float* tb, const FourProbes& pb, std::ptrdiff_t rb, int j,
+                                               int count, float step, Texel& mean_a, Texel& mean_b) {
+    const __m256 first = quads<kInside>(ta, pa.at[0], ra, tb, pb.at[0], rb, j);
+    __m256 difference = _mm256_setzero_ps();
+    for (int k = 1; k < count; ++k)
+        difference = _mm256_add_ps(difference, _mm256_sub_ps(quads<kInside>(ta, pa.at[k], ra, tb, pb.at[k], rb, j), first));
+    const __m256 mean = _mm256_add_ps(first, _mm256_mul_ps(difference, _mm256_set1_ps(step)));
+    mean_a = Texel(_mm256_castps256_ps128(mean)), mean_b = Texel(_mm256_extractf128_ps(mean, 1));
 }
 
 // Lanes first … first + n − 1 (n ≤ 4) of `lanes`.
@@ -243,72 +236,68 @@ bool vectors_reach(bool near, const TextureLevel& level) {
     const __m256d counts = _mm256_cvtepi32_pd(count);
     const __m256d step = _mm256_div_pd(_mm256_set1_pd(1.0), counts);
     const __m256d span = _mm256_mul_pd(_mm256_sub_pd(counts, _mm256_set1_pd(1.0)), step);
+    // Each lane's level(s): lanes past n take lane 0's, and a lane of one level its finer level
+    // for the coarser too (placed and summed, never read), so that no lane needs a test below.
+    const TextureLevel* level[2][4];
     bool two_levels = false;
-    for (int j = 0; j < n; ++j) two_levels |= lanes.coarser[first + j] != nullptr;
+    for (int j = 0; j < 4; ++j) {
+        const int i = first + (j < n ? j : 0);
+        level[0][j] = lanes.finer[i];
+        level[1][j] = lanes.coarser[i] ? lanes.coarser[i] : lanes.finer[i];
+        two_levels |= lanes.coarser[i] != nullptr;
+    }
+    const __m256d u = _mm256_maskload_pd(lanes.u + first, used), v = _mm256_maskload_pd(lanes.v + first, used);
+    const __m256d du = _mm256_maskload_pd(lanes.du + first, used), dv = _mm256_maskload_pd(lanes.dv + first, used);
     FourLines lines[2];
     for (int k = 0; k < (two_levels ? 2 : 1); ++k) {
-        const auto level = [&](int j) -> const TextureLevel* {
-            if (j >= n) return nullptr;
-            return k == 1 && lanes.coarser[first + j] ? lanes.coarser[first + j] : lanes.finer[first + j];
-        };
-        const TextureLevel* four[4] = {level(0), level(1), level(2), level(3)};
-        const auto size = [&](int TextureLevel::*dimension) {
-            const auto of = [&](int j) { return four[j] ? four[j]->*dimension : 1; };
-            return _mm_setr_epi32(of(0), of(1), of(2), of(3));
-        };
-        lines[k] = four_lines(_mm256_maskload_pd(lanes.u + first, used), _mm256_maskload_pd(lanes.v + first, used),
-                              _mm256_maskload_pd(lanes.du + first, used), _mm256_maskload_pd(lanes.dv + first, used),
-                              size(&TextureLevel::width), size(&TextureLevel::height), step, span, s);
+        const TextureLevel* const* four = level[k];
+        lines[k] = four_lines(u, v, du, dv, _mm_setr_epi32(four[0]->width, four[1]->width, four[2]->width, four[3]->width),
+                              _mm_setr_epi32(four[0]->height, four[1]->height, four[2]->height, four[3]->height), step,
+                              span, s);
     }
 
-    // The lanes the vectors take, and the longest of their lines.
-    int vector_lanes = 0, longest = 0;
-    for (int j = 0; j < n; ++j) {
-        const int i = first + j;
-        if (!vectors_reach(lines[0].near >> j & 1, *lanes.finer[i])) continue;
-        if (lanes.coarser[i] && !vectors_reach(lines[1].near >> j & 1, *lanes.coarser[i])) continue;
-        vector_lanes |= 1 << j;
-        longest = std::max(longest, lanes.count[i]);
-    }
-    // Whether every line the vectors take lies inside its level(s): then only each quad's first
+    // The lanes the vectors take (lines short enough, within reach of int indices), the longest of
+    // their lines, and whether all of those lie inside their levels: then only each quad's first
     // texel is placed.
-    const bool inside = (lines[0].inside & vector_lanes) == vector_lanes &&
-                        (!two_levels || (lines[1].inside & vector_lanes) == vector_lanes);
-    LineSum sums[2][4];
+    const int short_lines =
+        _mm_movemask_ps(_mm_castsi128_ps(_mm_cmplt_epi32(count, _mm_set1_epi32(kMostVectorProbes + 1))));
+    const int vector_lanes = ((1 << n) - 1) & short_lines & lines[0].near & (two_levels ? lines[1].near : 15);
+    const int inside_lanes = lines[0].inside & (two_levels ? lines[1].inside : 15);
+    const bool inside = (inside_lanes & vector_lanes) == vector_lanes;
+    int longest = 0;
+    for (int j = 0; j < n; ++j)
+        if (vector_lanes >> j & 1) longest = std::max(longest, lanes.count[first + j]);
     FourProbes probes[2];
-    for (int k0 = 0; k0 < longest; k0 += kChunk) {
-        const int chunk = std::min(kChunk, longest - k0);
-        for (int k = 0; k < (two_levels ? 2 : 1); ++k)
-            place_probes(lines[k], inside, step, k0, chunk, s, probes[k]);
-        for (int j = 0; j < n; ++j) {
-            const int i = first + j, end = std::min(k0 + chunk, lanes.count[i]);
-            if (!(vector_lanes >> j & 1) || end <= k0) continue;
-            const TextureLevel &finer = *lanes.finer[i], *coarser = lanes.coarser[i];
-            if (coarser && inside)
-                add_probes<true>(finer.texels.data(), probes[0], finer.width, coarser->texels.data(), probes[1],
-                                 coarser->width, j, k0, end, sums[0][j], sums[1][j]);
-            else if (coarser)
-                add_probes<false>(finer.texels.data(), probes[0], finer.width, coarser->texels.data(), probes[1],
-                                  coarser->width, j, k0, end, sums[0][j], sums[1][j]);
-            else if (inside)
-                add_probes<true>(finer.texels.data(), probes[0], finer.width, j, k0, end, sums[0][j]);
-            else
-                add_probes<false>(finer.texels.data(), probes[0], finer.width, j, k0, end, sums[0][j]);
-        }
-    }
+    for (int k = 0; k < (two_levels ? 2 : 1); ++k) place_probes(lines[k], inside, step, longest, s, probes[k]);
+
     alignas(32) double steps[4];
     _mm256_store_pd(steps, step);
     for (int j = 0; j < n; ++j) {
-        const int i = first + j;
-        const auto mean = [&](const LineSum& sum) {
-            return sum.first + sum.difference * splat(static_cast<float>(steps[j]));
-        };
-        const auto reference = [&](const TextureLevel& level) {
-            return anisotropic_line(level, s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
-        };
-        const bool vectors = vector_lanes >> j & 1;
-        mean_finer[i] = vectors ? mean(sums[0][j]) : reference(*lanes.finer[i]);
-        if (lanes.coarser[i]) mean_coarser[i] = vectors ? mean(sums[1][j]) : reference(*lanes.coarser[i]);
+        const int i = first + j, probes_j = lanes.count[i];
+        if (!(vector_lanes >> j & 1)) {  // the reference's
+            const auto line = [&](const TextureLevel& on) {
+                return anisotropic_line(on, s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], probes_j);
+            };
+            mean_finer[i] = line(*lanes.finer[i]);
+            if (lanes.coarser[i]) mean_coarser[i] = line(*lanes.coarser[i]);
+            continue;
+        }
+        const float step_j = static_cast<float>(steps[j]);
+        const float* finer = &level[0][j]->texels.data()->x;
+        const std::ptrdiff_t finer_row = std::ptrdiff_t{4} * level[0][j]->width;
+        if (two_levels) {
+            const float* coarser = &level[1][j]->texels.data()->x;
+            const std::ptrdiff_t coarser_row = std::ptrdiff_t{4} * level[1][j]->width;
+            if (inside)
+                line_means<true>(finer, probes[0], finer_row, coarser, probes[1], coarser_row, j, probes_j, step_j,
+                                 mean_finer[i], mean_coarser[i]);
+            else
+                line_means<false>(finer, probes[0], finer_row, coarser, probes[1], coarser_row, j, probes_j, step_j,
+                                  mean_finer[i], mean_coarser[i]);
+        } else {
+            mean_finer[i] = inside ? line_mean<true>(finer, probes[0], finer_row, j, probes_j, step_j)
+                                   : line_mean<false>(finer, probes[0], finer_row, j, probes_j, step_j);
+        }
     }
 }
 
