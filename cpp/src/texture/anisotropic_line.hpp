@@ -44,25 +44,30 @@ texel::Texel anisotropic_line(const TextureLevel& level, const Sampler& sampler,
                               double dv, int count);
 
 /// The lanes of a lookup batch that take lines of probes: lane i's lookup (u, v), its longer
-/// derivative (du, dv), its probe count and the level(s) it reads (coarser null: one level).
+/// derivative (du, dv), its probe count, the level(s) it reads (coarser null: one level) and the
+/// coarser one's weight, and the batch lane whose result it is.
 struct LineLanes {
     int n = 0;
     double u[kLookupBatch], v[kLookupBatch], du[kLookupBatch], dv[kLookupBatch];
     int count[kLookupBatch];
     const TextureLevel* finer[kLookupBatch];
     const TextureLevel* coarser[kLookupBatch];
+    float weight[kLookupBatch];
+    int out[kLookupBatch];
 };
 
-/// anisotropic_line for every lane i < lanes.n: mean_finer[i] on *finer[i] and, where coarser[i]
-/// is not null, mean_coarser[i] on *coarser[i] (one lane at a time: the four-lane batch path's).
-void anisotropic_line_means(const LineLanes& lanes, const Sampler& sampler, texel::Texel* mean_finer,
-                            texel::Texel* mean_coarser);
+/// Lane i of `lanes`: anisotropic_line on *finer[i] and, where coarser[i] is not null, blended
+/// towards the line on *coarser[i] by weight[i].
+glm::vec4 anisotropic_lines_lookup(const LineLanes& lanes, int i, const Sampler& sampler);
 
-/// anisotropic_line_means' bits with AVX2 (anisotropic_line_avx2.cpp), for repeat and clamp: the
-/// lines placed four lanes per vector, probe k of four lines in one vector, a lookup's two lines
-/// summed in the two halves of one register (lines of more than 16 probes, from a max_anisotropy
-/// above 16, one lane at a time). Only on a CPU with AVX2.
-void anisotropic_line_means_avx2(const LineLanes& lanes, const Sampler& sampler, texel::Texel* mean_finer,
-                                 texel::Texel* mean_coarser);
+/// out[lanes.out[i]] = anisotropic_lines_lookup(lanes, i, sampler) for every i < lanes.n, one lane
+/// at a time (the four-lane batch path's).
+void anisotropic_lines(const LineLanes& lanes, const Sampler& sampler, glm::vec4* out);
+
+/// anisotropic_lines' bits with AVX2 (anisotropic_line_avx2.cpp), for repeat and clamp: the lines
+/// placed four lanes per vector, probe k of four lines in one vector, a lookup's two lines summed
+/// in the two halves of one register (lines of more than 16 probes, from a max_anisotropy above
+/// 16, one lane at a time). Only on a CPU with AVX2.
+void anisotropic_lines_avx2(const LineLanes& lanes, const Sampler& sampler, glm::vec4* out);
 
 }  // namespace mipraster

@@ -211,22 +211,20 @@ template <bool kInside>
 }
 
 // line_mean on two levels at once, each level's sum in its own half of a register (the same bits
-// as one level at a time, half the instructions).
+// as one level at a time, half the instructions): the finer level's mean in the low half.
 template <bool kInside>
-[[gnu::target("avx2")]] inline void line_means(const float* ta, const FourProbes& pa, std::ptrdiff_t ra,
-                                               const float* tb, const FourProbes& pb, std::ptrdiff_t rb, int j,
-                                               int count, float step, Texel& mean_a, Texel& mean_b) {
+[[gnu::target("avx2")]] inline __m256 line_means(const float* ta, const FourProbes& pa, std::ptrdiff_t ra,
+                                                 const float* tb, const FourProbes& pb, std::ptrdiff_t rb, int j,
+                                                 int count, float step) {
     const __m256 first = quads<kInside>(ta, pa.at[0], ra, tb, pb.at[0], rb, j);
     __m256 difference = _mm256_setzero_ps();
     for (int k = 1; k < count; ++k)
         difference = _mm256_add_ps(difference, _mm256_sub_ps(quads<kInside>(ta, pa.at[k], ra, tb, pb.at[k], rb, j), first));
-    const __m256 mean = _mm256_add_ps(first, _mm256_mul_ps(difference, _mm256_set1_ps(step)));
-    mean_a = Texel(_mm256_castps256_ps128(mean)), mean_b = Texel(_mm256_extractf128_ps(mean, 1));
+    return _mm256_add_ps(first, _mm256_mul_ps(difference, _mm256_set1_ps(step)));
 }
 
 // Lanes first … first + n − 1 (n ≤ 4) of `lanes`.
-[[gnu::target("avx2")]] void four_lanes(const LineLanes& lanes, int first, int n, const Sampler& s, Texel* mean_finer,
-                                        Texel* mean_coarser) {
+[[gnu::target("avx2")]] void four_lanes(const LineLanes& lanes, int first, int n, const Sampler& s, glm::vec4* out) {
     // The inputs straight from the caller's arrays (lanes past n as zeros; their counts as 1): a
     // vector loaded from scalars just stored waits for them to reach the cache.
     const __m256i used = _mm256_cmpgt_epi64(_mm256_set1_epi64x(n), _mm256_setr_epi64x(0, 1, 2, 3));
@@ -274,12 +272,8 @@ template <bool kInside>
     _mm256_store_pd(steps, step);
     for (int j = 0; j < n; ++j) {
         const int i = first + j, probes_j = lanes.count[i];
-        if (!(vector_lanes >> j & 1)) {  // the reference's
-            const auto line = [&](const TextureLevel& on) {
-                return anisotropic_line(on, s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], probes_j);
-            };
-            mean_finer[i] = line(*lanes.finer[i]);
-            if (lanes.coarser[i]) mean_coarser[i] = line(*lanes.coarser[i]);
+        if (!(vector_lanes >> j & 1)) {
+            out[lanes.out[i]] = anisotropic_lines_lookup(lanes, i, s);
             continue;
         }
         const float step_j = static_cast<float>(steps[j]);
@@ -288,32 +282,30 @@ template <bool kInside>
         if (two_levels) {
             const float* coarser = &level[1][j]->texels.data()->x;
             const std::ptrdiff_t coarser_row = std::ptrdiff_t{4} * level[1][j]->width;
-            if (inside)
-                line_means<true>(finer, probes[0], finer_row, coarser, probes[1], coarser_row, j, probes_j, step_j,
-                                 mean_finer[i], mean_coarser[i]);
-            else
-                line_means<false>(finer, probes[0], finer_row, coarser, probes[1], coarser_row, j, probes_j, step_j,
-                                  mean_finer[i], mean_coarser[i]);
+            const __m256 means = inside ? line_means<true>(finer, probes[0], finer_row, coarser, probes[1], coarser_row,
+                                                           j, probes_j, step_j)
+                                        : line_means<false>(finer, probes[0], finer_row, coarser, probes[1],
+                                                            coarser_row, j, probes_j, step_j);
+            const Texel finer_mean = Texel(_mm256_castps256_ps128(means));
+            out[lanes.out[i]] = to_vec4(lanes.coarser[i] ? lerp(finer_mean, Texel(_mm256_extractf128_ps(means, 1)),
+                                                                lanes.weight[i])
+                                                         : finer_mean);
         } else {
-            mean_finer[i] = inside ? line_mean<true>(finer, probes[0], finer_row, j, probes_j, step_j)
-                                   : line_mean<false>(finer, probes[0], finer_row, j, probes_j, step_j);
+            out[lanes.out[i]] = to_vec4(inside ? line_mean<true>(finer, probes[0], finer_row, j, probes_j, step_j)
+                                               : line_mean<false>(finer, probes[0], finer_row, j, probes_j, step_j));
         }
     }
 }
 
 }  // namespace
 
-[[gnu::target("avx2")]] void anisotropic_line_means_avx2(const LineLanes& lanes, const Sampler& s, Texel* mean_finer,
-                                                         Texel* mean_coarser) {
-    for (int first = 0; first < lanes.n; first += 4)
-        four_lanes(lanes, first, std::min(4, lanes.n - first), s, mean_finer, mean_coarser);
+[[gnu::target("avx2")]] void anisotropic_lines_avx2(const LineLanes& lanes, const Sampler& s, glm::vec4* out) {
+    for (int first = 0; first < lanes.n; first += 4) four_lanes(lanes, first, std::min(4, lanes.n - first), s, out);
 }
 
 #else  // (other CPUs never call it: BatchSampler uses it only where AVX2 is)
 
-void anisotropic_line_means_avx2(const LineLanes& lanes, const Sampler& s, Texel* mean_finer, Texel* mean_coarser) {
-    anisotropic_line_means(lanes, s, mean_finer, mean_coarser);
-}
+void anisotropic_lines_avx2(const LineLanes& lanes, const Sampler& s, glm::vec4* out) { anisotropic_lines(lanes, s, out); }
 
 #endif
 

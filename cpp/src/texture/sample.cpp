@@ -380,14 +380,16 @@ Texel anisotropic_line(const TextureLevel& level, const Sampler& s, double u, do
     return probe_mean<TexelFilter::linear>(p, u, v, level, s);
 }
 
-void anisotropic_line_means(const LineLanes& lanes, const Sampler& s, Texel* mean_finer, Texel* mean_coarser) {
-    for (int i = 0; i < lanes.n; ++i) {
-        const auto line = [&](const TextureLevel& level) {
-            return anisotropic_line(level, s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
-        };
-        mean_finer[i] = line(*lanes.finer[i]);
-        if (lanes.coarser[i]) mean_coarser[i] = line(*lanes.coarser[i]);
-    }
+glm::vec4 anisotropic_lines_lookup(const LineLanes& lanes, int i, const Sampler& s) {
+    const auto line = [&](const TextureLevel& level) {
+        return anisotropic_line(level, s, lanes.u[i], lanes.v[i], lanes.du[i], lanes.dv[i], lanes.count[i]);
+    };
+    const Texel finer = line(*lanes.finer[i]);
+    return to_vec4(lanes.coarser[i] ? lerp(finer, line(*lanes.coarser[i]), lanes.weight[i]) : finer);
+}
+
+void anisotropic_lines(const LineLanes& lanes, const Sampler& s, glm::vec4* out) {
+    for (int i = 0; i < lanes.n; ++i) out[lanes.out[i]] = anisotropic_lines_lookup(lanes, i, s);
 }
 
 namespace {

@@ -313,12 +313,12 @@ struct ProbeLines {
     float rho2_scale[kLookupBatch];
 };
 
-// Fills `lines` for lanes 0 … n − 1 (rho2_scale arrives filled with 1); true when some lane
-// takes more than one probe.
-bool probe_lines(const LookupBatch& b, int n, int width, int height, int levels, const Sampler& s, ProbeLines& lines) {
+// Fills `lines` for lanes 0 … n − 1 (rho2_scale arrives filled with 1); gives how many lanes take
+// more than one probe.
+int probe_lines(const LookupBatch& b, int n, int width, int height, int levels, const Sampler& s, ProbeLines& lines) {
     typedef double Doubles __attribute__((vector_size(16)));
     typedef float Pair __attribute__((vector_size(8)));
-    bool some = false;
+    int taking = 0;
     for (int l = 0; l < n; l += 2) {  // (an odd count reads one unused lane)
         const auto widen = [&](const float* p) {
             Pair x;
@@ -338,10 +338,10 @@ bool probe_lines(const LookupBatch& b, int n, int width, int height, int levels,
             if (count == 1 || anisotropic_magnifies(std::max(x, y), s, levels)) continue;
             lines.count[k] = count;
             lines.rho2_scale[k] = 1.0f / static_cast<float>(count * count);
-            some = true;
+            ++taking;
         }
     }
-    return some;
+    return taking;
 }
 
 #if defined(__x86_64__)
@@ -349,14 +349,14 @@ bool probe_lines(const LookupBatch& b, int n, int width, int height, int levels,
 // square root and ⌈⌉ are exact-rounded in vectors too), so the same counts and factors. A lane
 // whose line anisotropic_magnifies' first test (kSurelyMinifying2) cannot settle asks it. (One
 // lane at a time, the division and the root were a tenth of a 16× anisotropic frame.)
-[[gnu::target("avx2")]] bool probe_lines_avx2(const LookupBatch& b, int n, int width, int height, int levels,
-                                              const Sampler& s, ProbeLines& lines) {
+[[gnu::target("avx2")]] int probe_lines_avx2(const LookupBatch& b, int n, int width, int height, int levels,
+                                             const Sampler& s, ProbeLines& lines) {
     const int max_n = most_probes(s.max_anisotropy);
     const __m256d most = _mm256_set1_pd(max_n), most2 = _mm256_set1_pd(double(max_n) * max_n);
     const __m256d w = _mm256_set1_pd(width), h = _mm256_set1_pd(height);
     const __m256d infinity = _mm256_set1_pd(std::numeric_limits<double>::infinity());
     const bool plain = lod_is_plain(s, levels);
-    bool some = false;
+    int taking = 0;
     for (int l = 0; l < n; l += 4) {
         const __m128i used = _mm_cmpgt_epi32(_mm_set1_epi32(n - l), _mm_setr_epi32(0, 1, 2, 3));
         const auto widen = [&](const float* p) __attribute__((target("avx2"))) {
@@ -389,13 +389,13 @@ bool probe_lines(const LookupBatch& b, int n, int width, int height, int levels,
                       _mm_div_ps(_mm_set1_ps(1.0f), _mm_cvtepi32_ps(_mm_mullo_epi32(counts, counts))));
         const int along_x = _mm256_movemask_pd(_mm256_cmp_pd(x, y, _CMP_GE_OQ));
         for (int k = 0; k < 4; ++k) lines.along_x[l + k] = along_x >> k & 1;
-        some |= take != 0;
+        taking += __builtin_popcount(take);
     }
-    return some;
+    return taking;
 }
 #else  // (other CPUs: the scalar lanes; never called)
-bool probe_lines_avx2(const LookupBatch& b, int n, int width, int height, int levels, const Sampler& s,
-                      ProbeLines& lines) {
+int probe_lines_avx2(const LookupBatch& b, int n, int width, int height, int levels, const Sampler& s,
+                     ProbeLines& lines) {
     return probe_lines(b, n, width, height, levels, s, lines);
 }
 #endif
@@ -429,6 +429,8 @@ bool BatchSampler::covers(const Sampler& s) {
 }
 
 const glm::vec4* BatchSampler::first_use(int k) { return level_texels_[k] = texture_.level(k).texels.data(); }
+
+const TextureLevel* BatchSampler::first_record_use(int k) { return level_records_[k] = &texture_.level(k); }
 
 namespace {
 
@@ -516,12 +518,12 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     const int levels = texture_.level_count();
     ProbeLines lines;
     std::fill(lines.rho2_scale, lines.rho2_scale + kLookupBatch, 1.0f);
-    const bool some_lines = s.footprint == FootprintFilter::anisotropic &&
-                            (vector_width_ == 8 ? probe_lines_avx2 : probe_lines)(b, n, texture_.width(),
-                                                                                  texture_.height(), levels, s, lines);
+    const int line_count = s.footprint != FootprintFilter::anisotropic ? 0
+                           : (vector_width_ == 8 ? probe_lines_avx2 : probe_lines)(b, n, texture_.width(),
+                                                                                   texture_.height(), levels, s, lines);
+    const bool some_lines = line_count > 0;
     // A batch whose lanes all take lines (a surface at a grazing angle) reads no quad of the plan.
-    bool only_lines = some_lines;
-    for (int l = 0; l < n && only_lines; ++l) only_lines = lines.count[l] > 1;
+    const bool only_lines = line_count == n;
     LanePlan plan;
     (vector_width_ == 8 ? plan_avx2 : plan_sse2)(b, lines.rho2_scale, n, !only_lines, s, texture_.width(),
                                                  texture_.height(), levels, plan);
@@ -539,36 +541,30 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
             __builtin_prefetch(t + plan.texel_float[0][2][l]);
         }
     }
-    // The lines of all the batch's lanes that take them, at once (lane l's is line_of[l]).
-    LineLanes line_lanes;
-    int line_of[kLookupBatch];
-    Texel finer_means[kLookupBatch], coarser_means[kLookupBatch];
+    // The lines of all the batch's lanes that take them, at once: the reference's lines of probes,
+    // on the plan's level(s).
     if (some_lines) {
+        LineLanes line_lanes;
         for (int l = 0; l < n; ++l) {
             if (!plan.finite[l] || lines.count[l] == 1) continue;
             const int i = line_lanes.n++;
-            line_of[l] = i;
+            line_lanes.out[i] = l;
             line_lanes.u[i] = b.u[l], line_lanes.v[i] = b.v[l];
             line_lanes.du[i] = lines.along_x[l] ? b.dudx[l] : b.dudy[l];
             line_lanes.dv[i] = lines.along_x[l] ? b.dvdx[l] : b.dvdy[l];
             line_lanes.count[i] = lines.count[l];
-            line_lanes.finer[i] = &texture_.level(plan.level[l]);
-            line_lanes.coarser[i] = plan.level_weight[l] > 0.0f ? &texture_.level(plan.level[l] + 1) : nullptr;
+            line_lanes.finer[i] = level_record(plan.level[l]);
+            line_lanes.weight[i] = plan.level_weight[l];
+            line_lanes.coarser[i] = plan.level_weight[l] > 0.0f ? level_record(plan.level[l] + 1) : nullptr;
         }
-        (vector_width_ == 8 ? anisotropic_line_means_avx2 : anisotropic_line_means)(line_lanes, s, finer_means,
-                                                                                     coarser_means);
+        (vector_width_ == 8 ? anisotropic_lines_avx2 : anisotropic_lines)(line_lanes, s, out);
     }
     for (int l = 0; l < n; ++l) {
         if (!plan.finite[l]) {
             out[l] = sample_texture(texture_, s, {b.u[l], b.v[l]}, {b.dudx[l], b.dvdx[l]}, {b.dudy[l], b.dvdy[l]});
             continue;
         }
-        if (some_lines && lines.count[l] > 1) {  // the reference's line of probes, on the plan's level(s)
-            const int i = line_of[l];
-            out[l] = to_vec4(plan.level_weight[l] > 0.0f ? lerp(finer_means[i], coarser_means[i], plan.level_weight[l])
-                                                         : finer_means[i]);
-            continue;
-        }
+        if (some_lines && lines.count[l] > 1) continue;  // (its line's)
         const auto quad = [&](int step) {
             const float* t = level_floats(plan.level[l] + step);
             const std::int32_t(&q)[4][kLookupBatch] = plan.texel_float[step];
