@@ -309,7 +309,7 @@ void plan_avx2(const LookupBatch& b, const float* rho2_scale, int count, bool qu
 // magnification and lanes that are not finite (the plan sends those to the reference).
 struct ProbeLines {
     std::int32_t count[kLookupBatch];
-    bool along_x[kLookupBatch];
+    std::int32_t along_x[kLookupBatch];  // −1: along the x derivative, 0: the y one
     float rho2_scale[kLookupBatch];
 };
 
@@ -331,7 +331,7 @@ int probe_lines(const LookupBatch& b, int n, int width, int height, int levels, 
         for (int k = l; k < l + 2 && k < n; ++k) {
             const double x = px2[k - l], y = py2[k - l];
             lines.count[k] = 1;
-            lines.along_x[k] = x >= y;
+            lines.along_x[k] = x >= y ? -1 : 0;
             if (x == y && y > 0.0) continue;  // one probe
             if (!(std::isfinite(x) && std::isfinite(y))) continue;
             const int count = anisotropic_probe_count(x, y, s.max_anisotropy);
@@ -387,8 +387,9 @@ int probe_lines(const LookupBatch& b, int n, int width, int height, int levels, 
         _mm_storeu_si128(reinterpret_cast<__m128i*>(lines.count + l), counts);
         _mm_storeu_ps(lines.rho2_scale + l,
                       _mm_div_ps(_mm_set1_ps(1.0f), _mm_cvtepi32_ps(_mm_mullo_epi32(counts, counts))));
-        const int along_x = _mm256_movemask_pd(_mm256_cmp_pd(x, y, _CMP_GE_OQ));
-        for (int k = 0; k < 4; ++k) lines.along_x[l + k] = along_x >> k & 1;
+        const __m256 along_x = _mm256_castpd_ps(_mm256_cmp_pd(x, y, _CMP_GE_OQ));  // (each mask's low half)
+        const __m256 low_halves = _mm256_permutevar8x32_ps(along_x, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(lines.along_x + l), _mm_castps_si128(_mm256_castps256_ps128(low_halves)));
         taking += __builtin_popcount(take);
     }
     return taking;
@@ -545,19 +546,33 @@ void BatchSampler::sample(const LookupBatch& batch, glm::vec4* out) {
     // on the plan's level(s).
     if (some_lines) {
         LineLanes line_lanes;
-        for (int l = 0; l < n; ++l) {
-            if (!plan.finite[l] || lines.count[l] == 1) continue;
-            const int i = line_lanes.n++;
-            line_lanes.out[i] = l;
-            line_lanes.u[i] = b.u[l], line_lanes.v[i] = b.v[l];
-            line_lanes.du[i] = lines.along_x[l] ? b.dudx[l] : b.dudy[l];
-            line_lanes.dv[i] = lines.along_x[l] ? b.dvdx[l] : b.dvdy[l];
-            line_lanes.count[i] = lines.count[l];
+        std::int32_t every_lane_finite = -1;
+        for (int l = 0; l < n; ++l) every_lane_finite &= plan.finite[l];
+        if (only_lines && every_lane_finite) {  // lane l's line is line l: field by field (loops that vectorize)
+            line_lanes.n = n;
+            for (int l = 0; l < n; ++l) line_lanes.out[l] = l, line_lanes.count[l] = lines.count[l];
+            for (int l = 0; l < n; ++l) line_lanes.u[l] = b.u[l], line_lanes.v[l] = b.v[l];
+            for (int l = 0; l < n; ++l) line_lanes.du[l] = lines.along_x[l] ? b.dudx[l] : b.dudy[l];
+            for (int l = 0; l < n; ++l) line_lanes.dv[l] = lines.along_x[l] ? b.dvdx[l] : b.dvdy[l];
+            std::memcpy(line_lanes.weight, plan.level_weight, sizeof plan.level_weight);
+        } else {
+            for (int l = 0; l < n; ++l) {
+                if (!plan.finite[l] || lines.count[l] == 1) continue;
+                const int i = line_lanes.n++;
+                line_lanes.out[i] = l, line_lanes.count[i] = lines.count[l];
+                line_lanes.u[i] = b.u[l], line_lanes.v[i] = b.v[l];
+                line_lanes.du[i] = lines.along_x[l] ? b.dudx[l] : b.dudy[l];
+                line_lanes.dv[i] = lines.along_x[l] ? b.dvdx[l] : b.dvdy[l];
+                line_lanes.weight[i] = plan.level_weight[l];
+            }
+        }
+        for (int i = 0; i < line_lanes.n; ++i) {
+            const int l = line_lanes.out[i];
             line_lanes.finer[i] = level_record(plan.level[l]);
-            line_lanes.weight[i] = plan.level_weight[l];
             line_lanes.coarser[i] = plan.level_weight[l] > 0.0f ? level_record(plan.level[l] + 1) : nullptr;
         }
         (vector_width_ == 8 ? anisotropic_lines_avx2 : anisotropic_lines)(line_lanes, s, out);
+        if (line_lanes.n == n) return;  // (every lane's)
     }
     for (int l = 0; l < n; ++l) {
         if (!plan.finite[l]) {
