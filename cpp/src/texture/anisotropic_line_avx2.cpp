@@ -120,16 +120,19 @@ struct FourProbes {
     ProbeSlot at[kMostVectorProbes];
 };
 
-// `inside`: the lines whose probes are read all lie inside their levels; then only a quad's first
+// Probe numbers as doubles, for t = c·step without a conversion.
+constexpr double kProbeNumbers[kMostVectorProbes] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+
+// kInside: the lines whose probes are read all lie inside their levels; then only a quad's first
 // texel is placed, ⌊y⌋·width + ⌊x⌋ in double (exact: below the level's texel count, which fits an
 // int); else all four, their indices wrapped.
-[[gnu::target("avx2")]] void place_probes(const FourLines& f, bool inside, __m256d step, int n, const Sampler& s,
-                                          FourProbes& p) {
+template <bool kInside>
+[[gnu::target("avx2")]] void place_probes(const FourLines& f, __m256d step, int n, const Sampler& s, FourProbes& p) {
     const __m256d width = _mm256_cvtepi32_pd(f.width);
     const __m128i one = _mm_set1_epi32(1);
     for (int c = 0; c < n; ++c) {
         ProbeSlot& at = p.at[c];
-        const __m256d t = _mm256_mul_pd(_mm256_set1_pd(c), step);
+        const __m256d t = _mm256_mul_pd(_mm256_broadcast_sd(&kProbeNumbers[c]), step);
         const __m256d x = _mm256_add_pd(f.x0, _mm256_mul_pd(t, f.sx));
         const __m256d y = _mm256_add_pd(f.y0, _mm256_mul_pd(t, f.sy));
         const __m256d fx = _mm256_floor_pd(x), fy = _mm256_floor_pd(y);
@@ -138,7 +141,7 @@ struct FourProbes {
         // Past a line's end, or on a line the reference takes, a value may exceed the int range:
         // the conversion gives INT_MIN there (and the shifts and sums below wrap around, defined;
         // unread).
-        if (inside) {  // (the other corners follow from the first: see quad)
+        if constexpr (kInside) {  // (the other corners follow from the first: see quad)
             const __m128i texel = _mm256_cvttpd_epi32(_mm256_add_pd(_mm256_mul_pd(fy, width), fx));
             _mm_storeu_si128(reinterpret_cast<__m128i*>(at.texel_float[0]), _mm_slli_epi32(texel, 2));
             continue;
@@ -266,7 +269,8 @@ template <bool kInside>
     for (int j = 0; j < n; ++j)
         if (vector_lanes >> j & 1) longest = std::max(longest, lanes.count[first + j]);
     FourProbes probes[2];
-    for (int k = 0; k < (two_levels ? 2 : 1); ++k) place_probes(lines[k], inside, step, longest, s, probes[k]);
+    for (int k = 0; k < (two_levels ? 2 : 1); ++k)
+        (inside ? place_probes<true> : place_probes<false>)(lines[k], step, longest, s, probes[k]);
 
     alignas(32) double steps[4];
     _mm256_store_pd(steps, step);
