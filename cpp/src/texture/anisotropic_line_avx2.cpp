@@ -160,8 +160,8 @@ template <bool kInside>
 }
 
 // The bilinear quad of probe `at` on line j, on a level whose texels' floats start at t and whose
-// rows are `row` floats long. kInside: the group's lines lie inside their levels, and only each quad's
-// first texel was placed; the others are the next one and the two below them.
+// rows are `row` floats long. kInside: the group's lines lie inside their levels, and only each
+// quad's first texel was placed; the others are the next one and the two below them.
 template <bool kInside>
 [[gnu::target("avx2")]] inline Texel quad(const float* t, const ProbeSlot& at, int j, std::ptrdiff_t row) {
     if constexpr (kInside) {
@@ -210,7 +210,8 @@ template <bool kInside>
         for (int k = 0; k < 4; ++k) corner[k] = pair(ta + pa.texel_float[k][j], tb + pb.texel_float[k][j]);
     }
     const __m256 fx = halves(pa.fx[j], pb.fx[j]);
-    return lerp_pair(lerp_pair(corner[0], corner[1], fx), lerp_pair(corner[2], corner[3], fx), halves(pa.fy[j], pb.fy[j]));
+    return lerp_pair(lerp_pair(corner[0], corner[1], fx), lerp_pair(corner[2], corner[3], fx),
+                     halves(pa.fy[j], pb.fy[j]));
 }
 
 // line_mean on two levels at once, each level's sum in its own half of a register (the same bits
@@ -221,8 +222,10 @@ template <bool kInside>
                                                  int count, float step) {
     const __m256 first = quads<kInside>(ta, pa.at[0], ra, tb, pb.at[0], rb, j);
     __m256 difference = _mm256_setzero_ps();
-    for (int k = 1; k < count; ++k)
-        difference = _mm256_add_ps(difference, _mm256_sub_ps(quads<kInside>(ta, pa.at[k], ra, tb, pb.at[k], rb, j), first));
+    for (int k = 1; k < count; ++k) {
+        const __m256 probe = quads<kInside>(ta, pa.at[k], ra, tb, pb.at[k], rb, j);
+        difference = _mm256_add_ps(difference, _mm256_sub_ps(probe, first));
+    }
     return _mm256_add_ps(first, _mm256_mul_ps(difference, _mm256_set1_ps(step)));
 }
 
@@ -252,9 +255,9 @@ template <bool kInside>
     FourLines lines[2];
     for (int k = 0; k < (two_levels ? 2 : 1); ++k) {
         const TextureLevel* const* four = level[k];
-        lines[k] = four_lines(u, v, du, dv, _mm_setr_epi32(four[0]->width, four[1]->width, four[2]->width, four[3]->width),
-                              _mm_setr_epi32(four[0]->height, four[1]->height, four[2]->height, four[3]->height), step,
-                              span, s);
+        const __m128i width = _mm_setr_epi32(four[0]->width, four[1]->width, four[2]->width, four[3]->width);
+        const __m128i height = _mm_setr_epi32(four[0]->height, four[1]->height, four[2]->height, four[3]->height);
+        lines[k] = four_lines(u, v, du, dv, width, height, step, span, s);
     }
 
     // The lanes the vectors take (lines short enough, within reach of int indices), the longest of
@@ -309,7 +312,9 @@ template <bool kInside>
 
 #else  // (other CPUs never call it: BatchSampler uses it only where AVX2 is)
 
-void anisotropic_lines_avx2(const LineLanes& lanes, const Sampler& s, glm::vec4* out) { anisotropic_lines(lanes, s, out); }
+void anisotropic_lines_avx2(const LineLanes& lanes, const Sampler& s, glm::vec4* out) {
+    anisotropic_lines(lanes, s, out);
+}
 
 #endif
 

@@ -389,7 +389,8 @@ int probe_lines(const LookupBatch& b, int n, int width, int height, int levels, 
                       _mm_div_ps(_mm_set1_ps(1.0f), _mm_cvtepi32_ps(_mm_mullo_epi32(counts, counts))));
         const __m256 along_x = _mm256_castpd_ps(_mm256_cmp_pd(x, y, _CMP_GE_OQ));  // (each mask's low half)
         const __m256 low_halves = _mm256_permutevar8x32_ps(along_x, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(lines.along_x + l), _mm_castps_si128(_mm256_castps256_ps128(low_halves)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(lines.along_x + l),
+                         _mm_castps_si128(_mm256_castps256_ps128(low_halves)));
         taking += __builtin_popcount(take);
     }
     return taking;
