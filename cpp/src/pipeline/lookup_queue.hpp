@@ -97,16 +97,14 @@ public:
             int n = count_;
             const int j = __builtin_ctz(pixels);
             const std::uint64_t from_j = std::uint64_t{pixels} >> j;
-            if (!samples && (from_j & (from_j + 1)) == 0) {
+            if ((from_j & (from_j + 1)) == 0) {
                 // The row's pixels left are one run (a triangle's span, all tested passed): field
                 // by field, in loops that vectorize (pixel by pixel it was 27 instructions each).
                 const int take = std::min(__builtin_popcountll(from_j), kLookupBatch - n);
-                std::memcpy(weights_.l0 + n, l0 + j, take * sizeof(double));
-                std::memcpy(weights_.l1 + n, l1 + j, take * sizeof(double));
-                std::memcpy(weights_.l2 + n, l2 + j, take * sizeof(double));
                 for (int k = 0; k < take; ++k) {
+                    weights_.l0[n + k] = l0[j + k], weights_.l1[n + k] = l1[j + k], weights_.l2[n + k] = l2[j + k];
                     pending_.target[n + k] = row_target + stride * (j + k);
-                    pending_.samples[n + k] = 1;
+                    pending_.samples[n + k] = samples ? samples[j + k] : 1;
                     pending_.triangle[n + k] = current_;
                     pending_.px[n + k] = x0 + j + k;
                     pending_.py[n + k] = y;
