@@ -7,7 +7,6 @@
 // still sees the first result under the second.
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 
 #include <glm/vec4.hpp>
@@ -98,8 +97,8 @@ public:
             const int j = __builtin_ctz(pixels);
             const std::uint64_t from_j = std::uint64_t{pixels} >> j;
             if ((from_j & (from_j + 1)) == 0) {
-                // The row's pixels left are one run (a triangle's span, all tested passed): field
-                // by field, in loops that vectorize (pixel by pixel it was 27 instructions each).
+                // The row's pixels left are one run (a triangle's span where every pixel passed):
+                // field by field, in loops that vectorize (pixel by pixel it was 27 instructions each).
                 const int take = std::min(__builtin_popcountll(from_j), kLookupBatch - n);
                 for (int k = 0; k < take; ++k) {
                     weights_.l0[n + k] = l0[j + k], weights_.l1[n + k] = l1[j + k], weights_.l2[n + k] = l2[j + k];
