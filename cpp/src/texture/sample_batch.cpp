@@ -448,8 +448,6 @@ bool BatchSampler::covers(const Sampler& s) {
            wrap(s.wrap_u) && wrap(s.wrap_v);
 }
 
-const glm::vec4* BatchSampler::first_use(int k) { return level_texels_[k] = texture_.level(k).texels.data(); }
-
 const TextureLevel* BatchSampler::first_record_use(int k) { return level_records_[k] = &texture_.level(k); }
 
 namespace {

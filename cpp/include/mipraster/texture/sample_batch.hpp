@@ -83,15 +83,12 @@ private:
     Sampler sampler_;
     bool covered_;
     int vector_width_;
-    // Texels of the levels read so far (null: not asked for yet; asking may build it).
-    const glm::vec4* level_texels_[32] = {};
-    const glm::vec4* level(int k) { return level_texels_[k] ? level_texels_[k] : first_use(k); }
-    const glm::vec4* first_use(int k);
-    // The levels read so far themselves (null: not asked for yet).
+    // The levels read so far (null: not asked for yet; asking may build it), and their texels'
+    // floats, RGBA by RGBA.
     const TextureLevel* level_records_[32] = {};
     const TextureLevel* level_record(int k) { return level_records_[k] ? level_records_[k] : first_record_use(k); }
     const TextureLevel* first_record_use(int k);
-    const float* level_floats(int k) { return &level(k)->x; }  // (the texels' floats, RGBA by RGBA)
+    const float* level_floats(int k) { return &level_record(k)->texels.data()->x; }
 };
 
 }  // namespace mipraster
