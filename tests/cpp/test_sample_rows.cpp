@@ -85,6 +85,48 @@ TEST(SampleRows, SameBitsAndCountersAsThePerSamplePathOnOverlappingScenes) {
     }
 }
 
+// Small triangles (a few pixels, and slivers under 8 pixels wide but up to the viewport's height)
+// at one sample a pixel take box_coverage_avx2 for their whole box and then only their covered
+// pixels: the same bits and counters as the per-sample path, textured or not, flat, blended, with
+// and without depth writes, block skipping and deferred shading.
+TEST(SampleRows, SmallTrianglesABoxAtATimeGiveThePerSampleBits) {
+    const int W = 96, H = 80;
+    mr::Mesh small = random_triangles(3000, 0.12, 51, {-1.5, -1.0, -2.0}, {3.0, 2.0, 5.0}, 0.5);
+    mr::Mesh slivers = random_triangles(200, 3.0, 52, {-1.5, -1.0, -2.0}, {3.0, 2.0, 5.0}, 0.5);
+    for (glm::vec3& p : slivers.positions) p.x /= 30.0f;  // (1/30 as wide as tall)
+    const auto base = static_cast<std::uint32_t>(small.positions.size());
+    small.positions.insert(small.positions.end(), slivers.positions.begin(), slivers.positions.end());
+    small.colors.insert(small.colors.end(), slivers.colors.begin(), slivers.colors.end());
+    for (const glm::uvec3& tri : slivers.triangles) small.triangles.push_back(tri + base);
+    for (const glm::vec3& p : small.positions) small.uvs.push_back(glm::vec2(5.0f * p.x + p.z, 7.0f * p.y));
+    const mr::Texture texture = checker_texture();
+    for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
+        const mr::Camera cam = overlap_camera(convention, W, H);
+        for (mr::BlendMode blend : {mr::BlendMode::replace, mr::BlendMode::over})
+            for (bool skipping : {false, true})
+                for (bool deferred : {false, true}) {
+                    mr::DrawState tested;
+                    tested.blend = blend;
+                    mr::DrawState read_only = tested;
+                    read_only.depth_write = false;
+                    read_only.interpolation = mr::Interpolation::flat;
+                    std::vector<mr::Draw> draws = {make_draw(small, glm::dmat4(1.0), tested),
+                                                   make_draw(small, glm::dmat4(1.0), tested, glm::vec4(0.3f, 0.8f, 0.5f, 1.0f)),
+                                                   make_draw(small, glm::dmat4(1.0), read_only, glm::vec4(0.9f)),
+                                                   make_draw(small, glm::dmat4(1.0), no_depth(blend), glm::vec4(0.5f))};
+                    draws[0].texture = texture;
+                    SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(blend) +
+                                 (skipping ? ", block skipping" : "") + (deferred ? ", deferred" : ""));
+                    auto s = settings(W, H, 1, mr::PatternKind::automatic);
+                    s.threads = 1;
+                    s.block_skipping = skipping;
+                    s.deferred_shading = deferred;
+                    s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+                    expect_same_with_and_without_rows(draws, cam, s);
+                }
+    }
+}
+
 TEST(SampleRows, AlphaTestedRowsGiveThePerSampleBits) {
     // An alpha-tested draw tests its long rows a vector at a time without writing depth, and writes
     // the depth and colour of what survives its alpha test afterwards: the per-sample path's bits
@@ -507,6 +549,57 @@ TEST(SampleRows, CoverageMasksFourSamplesPerVectorAreTheExactPerSampleTest) {
     std::cout << "rows " << rows << ", samples on an edge " << on_edges << ", inside " << inside << ", outside "
               << outside << "\n";
     EXPECT_GE(rows, 15000);
+    EXPECT_GE(on_edges, 200);
+    EXPECT_GE(inside, 50000);
+    EXPECT_GE(outside, 50000);
+}
+
+// box_coverage_avx2 (small triangles at one sample a pixel: a box of up to 8 pixels by up to a
+// tile's rows at once) against the exact test at each pixel's centre: all three integer edge
+// values ≥ 0. Boxes start left of and above the triangle and run past it; half the triangles'
+// edges run through pixel centres (edge values of exactly 0 and −1 are common).
+TEST(SampleRows, BoxCoverageIsTheExactPerPixelTest) {
+    if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2, which box_coverage_avx2 needs";
+    std::mt19937_64 rng(64);
+    long boxes = 0, on_edges = 0, inside = 0, outside = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        mr::SetupTriangle t;
+        if (!random_row_triangle(rng, trial, t)) continue;
+        const int x0 = t.min_x - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_x - t.min_x + 3));
+        const int y0 = t.min_y - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_y - t.min_y + 3));
+        const int n = 1 + static_cast<int>(rng() % 8), rows = 1 + static_cast<int>(rng() % mr::kTileSize);
+        const std::int64_t X = std::int64_t{x0} * mr::kSubpixelOne, Y = std::int64_t{y0} * mr::kSubpixelOne;
+        const std::int64_t half = mr::kSubpixelOne / 2;
+        std::int64_t first[3], step_x[3], step_y[3];
+        for (int i = 0; i < 3; ++i) {
+            first[i] = t.edge_a[i] * (X + half) + t.edge_b[i] * (Y + half) + t.edge_c[i];
+            step_x[i] = std::int64_t{t.edge_a[i]} * mr::kSubpixelOne;
+            step_y[i] = std::int64_t{t.edge_b[i]} * mr::kSubpixelOne;
+        }
+        std::uint8_t cover[mr::kTileSize];
+        const std::uint32_t any = mr::kernels::box_coverage_avx2(first, step_x, step_y, n, rows, cover);
+        std::uint32_t want_any = 0;
+        for (int r = 0; r < rows; ++r) {
+            std::uint32_t want = 0;
+            for (int j = 0; j < n; ++j) {
+                std::int64_t E[3];
+                for (int i = 0; i < 3; ++i)
+                    E[i] = t.edge_a[i] * (X + j * mr::kSubpixelOne + half) +
+                           t.edge_b[i] * (Y + r * mr::kSubpixelOne + half) + t.edge_c[i];
+                on_edges += E[0] == 0 || E[1] == 0 || E[2] == 0;
+                if (E[0] >= 0 && E[1] >= 0 && E[2] >= 0) want |= 1u << j;
+            }
+            ASSERT_EQ(cover[r], want) << "trial " << trial << " row " << r << " of " << rows << ", " << n << " pixels";
+            want_any |= want;
+            inside += __builtin_popcount(want);
+            outside += n - __builtin_popcount(want);
+        }
+        ASSERT_EQ(any, want_any) << "trial " << trial;
+        ++boxes;
+    }
+    std::cout << "boxes " << boxes << ", pixels on an edge " << on_edges << ", inside " << inside << ", outside "
+              << outside << "\n";
+    EXPECT_GE(boxes, 15000);
     EXPECT_GE(on_edges, 200);
     EXPECT_GE(inside, 50000);
     EXPECT_GE(outside, 50000);

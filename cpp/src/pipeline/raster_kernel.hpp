@@ -315,6 +315,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     // Coverage masks four samples per vector (pixel_coverage_avx2; also MSAA's depth tests,
     // pixel_vectors below).
     const bool vector_masks = target.sample_rows && S % 4 == 0 && BatchSampler::widest_vector() == 8;
+    // Small triangles' pixels at one sample a pixel found a box at a time (box_coverage_avx2).
+    const bool box_rows = kMode == SampleMode::single && target.sample_rows && BatchSampler::widest_vector() == 8;
     std::optional<LookupQueue<kBlend, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
     // An alpha-tested draw's batched lookups (alpha_tested_triangle), where a draw without a cutoff
@@ -513,6 +515,53 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
             queue->push_row(color_out.at(rx0, py, 0), 4 * S, pixels, l0, l1, l2, rx0, py, samples);
         };
+
+        // At one sample a pixel, a triangle narrower than a sample row with no block classified
+        // (most of many_small's): the coverage of its whole box at once (box_coverage_avx2), then
+        // its covered pixels in the order of the rows below, without their rows' set-up or the
+        // tests of the pixels it misses (many_small 1x: a third of the kernel's instructions).
+        if (box_rows && !classified && x1 - x0 < kSampleRowMinPixels) {
+            // Edge values at the sample of pixel (x0, y0), and the pixel's slots: the per-sample
+            // path's integers, and addresses from the windows' fields read once.
+            const std::int64_t X = std::int64_t{x0} * kStep, Y = std::int64_t{y0} * kStep;
+            std::int64_t e[3] = {t.edge_a[0] * X + t.edge_b[0] * Y + t.edge_c[0] + off0[0],
+                                 t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1] + off1[0],
+                                 t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2] + off2[0]};
+            const std::int64_t down[3] = {t.edge_b[0] * kStep, t.edge_b[1] * kStep, t.edge_b[2] * kStep};
+            std::uint8_t cover[kTileSize];
+            if (!box_coverage_avx2(e, {step0, step1, step2}, down, x1 - x0, y1 - y0, cover)) continue;
+            float* depth_row = kDepth != DepthFunc::none ? depth_out.at(x0, y0, 0) : nullptr;
+            float* color_row = colour_slots(x0, y0);
+            const std::ptrdiff_t depth_pixel = kDepth != DepthFunc::none ? depth_out.samples * depth_out.channels : 0;
+            const std::ptrdiff_t depth_line = depth_pixel * depth_out.pitch;
+            const std::ptrdiff_t color_pixel = color_out.samples * color_out.channels;
+            const std::ptrdiff_t color_line = color_pixel * color_out.pitch;
+            for (int py = y0; py < y1; ++py) {
+                // The per-sample path's steps for sample 0 of each covered pixel.
+                for (std::uint32_t m = cover[py - y0]; m; m &= m - 1) {
+                    const int j = __builtin_ctz(m);
+                    ++counters.samples_covered;
+                    glm::dvec3 l(0.0);
+                    if constexpr (kDepth != DepthFunc::none || kShading == Shading::screen ||
+                                  kShading == Shading::perspective || kShading == Shading::visibility ||
+                                  kTexturing != Texturing::none)
+                        l = screen_weights(t, e[0] + j * step0, e[1] + j * step1, e[2] + j * step2);
+                    if constexpr (kDepth != DepthFunc::none) {
+                        float* const depth = depth_row + j * depth_pixel;
+                        const float z = sample_depth(t, l);
+                        if (!depth_passes<kDepth>(z, *depth)) continue;
+                        if (draw.depth_write) *depth = z;
+                    }
+                    passed_sample(kShading == Shading::visibility ? nullptr : color_row + j * color_pixel, x0 + j, py,
+                                  0, l);
+                    if constexpr (kDepth != DepthFunc::none) blocks.written(x0 + j, py);
+                }
+                for (int k = 0; k < 3; ++k) e[k] += down[k];
+                depth_row += depth_line;
+                if constexpr (kShading != Shading::visibility) color_row += color_line;
+            }
+            continue;
+        }
 
         for (int py = y0; py < y1; ++py) {
             int rx0 = x0, rx1 = x1;  // the row without skipped blocks at its ends
