@@ -306,8 +306,8 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
 template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode, Texturing kTexturing>
 void raster_tile(const TileTarget& target, const DrawInputs& draw, const TriangleBatch& batch,
                  TileCounters& counters) {
-    const SampleWindow& color_out = target.color;
-    const SampleWindow& depth_out = target.depth;
+    const SampleWindow color_out = target.color;  // (copies: fields no store through a float* can change)
+    const SampleWindow depth_out = target.depth;
     const SamplePattern& pattern = *target.pattern;
     const int S = kMode == SampleMode::single ? 1 : pattern.count();
     constexpr std::int64_t kStep = kSubpixelOne;  // one pixel in fixed point
