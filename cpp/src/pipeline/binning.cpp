@@ -96,7 +96,8 @@ ChunkBinner::ChunkBinner(BinnedChunk& chunk, const TileGrid& grid, bool overlap_
 }
 
 void ChunkBinner::add(const SetupTriangle& t) {
-    const auto tile_of = [](int pixel) { return static_cast<std::uint16_t>(pixel / kTileSize); };
+    // (Bounds lie inside the viewport, ≥ 0: an unsigned division, a shift, without the sign's fix-up.)
+    const auto tile_of = [](int pixel) { return static_cast<std::uint16_t>(static_cast<unsigned>(pixel) / kTileSize); };
     const TileSpan span{tile_of(t.min_x), tile_of(t.min_y), tile_of(t.max_x), tile_of(t.max_y)};
     spans_.push_back(span);
     if (span.x0 == span.x1 && span.y0 == span.y1) {  // most small triangles: one tile
