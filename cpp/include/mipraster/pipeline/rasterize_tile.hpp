@@ -63,7 +63,8 @@ struct TileTarget {
     /// fail everywhere (the output is the same either way; false runs the plain per-sample path).
     bool block_skipping = true;
     /// Depth tested, one sample per pixel or SSAA: rows of pixels through test_sample_row; MSAA:
-    /// a pixel's samples through test_pixel_samples_avx2 (RenderSettings::sample_rows).
+    /// a pixel's samples through test_pixel_samples_avx2; one sample per pixel: small triangles'
+    /// boxes through box_coverage_avx2 (RenderSettings::sample_rows).
     bool sample_rows = true;
     /// Deferred shading only (heavy overdraw, see renderer.cpp). The pre-pass (Shading::visibility with owners set)
     /// records per sample the index into owner_refs of the triangle whose colour the sample ends

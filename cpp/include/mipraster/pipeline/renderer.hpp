@@ -63,9 +63,10 @@ struct RenderSettings {
     bool block_skipping = true;
     /// At one sample per pixel and under SSAA, a depth-tested triangle's coverage, weights and
     /// depth tests along a row of pixels run four pixels per vector (sample by sample); under MSAA
-    /// (a multiple of four samples, AVX2) a pixel's depth tests run four samples per vector. The
-    /// output and counters are the same bits either way; false runs the per-sample path, for
-    /// comparison.
+    /// (a multiple of four samples, AVX2) a pixel's depth tests run four samples per vector; at one
+    /// sample per pixel (AVX2), a triangle narrower than 8 pixels finds its whole box's coverage at
+    /// once. The output and counters are the same bits either way; false runs the per-sample path,
+    /// for comparison.
     bool sample_rows = true;
     /// Where a tile's triangles overlap kDeferredMinOverdraw deep or more (MSAA: textured draws,
     /// kDeferredMinOverdrawMsaa) and every one of them is of a draw that replaces without an alpha
