@@ -110,10 +110,11 @@ TEST(SampleRows, SmallTrianglesABoxAtATimeGiveThePerSampleBits) {
                     mr::DrawState read_only = tested;
                     read_only.depth_write = false;
                     read_only.interpolation = mr::Interpolation::flat;
-                    std::vector<mr::Draw> draws = {make_draw(small, glm::dmat4(1.0), tested),
-                                                   make_draw(small, glm::dmat4(1.0), tested, glm::vec4(0.3f, 0.8f, 0.5f, 1.0f)),
-                                                   make_draw(small, glm::dmat4(1.0), read_only, glm::vec4(0.9f)),
-                                                   make_draw(small, glm::dmat4(1.0), no_depth(blend), glm::vec4(0.5f))};
+                    const glm::dmat4 identity(1.0);
+                    std::vector<mr::Draw> draws = {make_draw(small, identity, tested),
+                                                   make_draw(small, identity, tested, glm::vec4(0.3f, 0.8f, 0.5f, 1)),
+                                                   make_draw(small, identity, read_only, glm::vec4(0.9f)),
+                                                   make_draw(small, identity, no_depth(blend), glm::vec4(0.5f))};
                     draws[0].texture = texture;
                     SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(blend) +
                                  (skipping ? ", block skipping" : "") + (deferred ? ", deferred" : ""));

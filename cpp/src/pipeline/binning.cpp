@@ -96,7 +96,7 @@ ChunkBinner::ChunkBinner(BinnedChunk& chunk, const TileGrid& grid, bool overlap_
 }
 
 void ChunkBinner::add(const SetupTriangle& t) {
-    // (Bounds lie inside the viewport, ≥ 0: an unsigned division, a shift, without the sign's fix-up.)
+    // (Bounds lie inside the viewport, ≥ 0: an unsigned division, a shift without a sign fix-up.)
     const auto tile_of = [](int pixel) { return static_cast<std::uint16_t>(static_cast<unsigned>(pixel) / kTileSize); };
     const TileSpan span{tile_of(t.min_x), tile_of(t.min_y), tile_of(t.max_x), tile_of(t.max_y)};
     spans_.push_back(span);
