@@ -451,7 +451,8 @@ TEST(SampleRows, PixelRowsGiveThePerSampleArithmeticOnRandomRows) {
         const bool depth_write = rng() % 2;
 
         // The per-sample reference.
-        std::vector<float> depth(static_cast<std::size_t>(n * S)), want_depth;
+        std::vector<float> depth(static_cast<std::size_t>(n * S)), want_depth, want_tested(depth.size());
+        std::vector<char> want_covered_at(depth.size());
         std::uint64_t want_covered = 0, want_samples[mr::kTileSize] = {};
         for (int j = 0; j < n; ++j)
             for (int s = 0; s < S; ++s) {
@@ -466,6 +467,8 @@ TEST(SampleRows, PixelRowsGiveThePerSampleArithmeticOnRandomRows) {
                 on_edges += E[0] == 0 || E[1] == 0 || E[2] == 0;
                 if ((E[0] | E[1] | E[2]) < 0) continue;
                 ++want_covered;
+                want_covered_at[static_cast<std::size_t>(j * S + s)] = 1;
+                want_tested[static_cast<std::size_t>(j * S + s)] = z;
                 if (!(func == mr::DepthFunc::greater ? z > stored : z < stored)) continue;
                 want_samples[j] |= std::uint64_t{1} << s;
             }
@@ -482,18 +485,30 @@ TEST(SampleRows, PixelRowsGiveThePerSampleArithmeticOnRandomRows) {
                 }
 
         std::uint64_t samples[mr::kTileSize];
+        std::vector<float> tested(static_cast<std::size_t>(n * S), -1.0f);
         const double* const offset_rows[3] = {offsets[0], offsets[1], offsets[2]};
-        const std::uint64_t covered =
-            mr::kernels::test_pixel_row_avx2(t, corner, n, offset_rows, S, func, depth_write, depth.data(), samples);
-        ASSERT_EQ(covered, want_covered) << "trial " << trial;
+        const bool keep_tested = trial % 2 == 0;
+        const mr::kernels::PixelRowTest found =
+            mr::kernels::test_pixel_row_avx2(t, corner, n, offset_rows, S, func, depth_write, depth.data(), samples,
+                                             keep_tested ? tested.data() : nullptr);
+        ASSERT_EQ(found.covered, want_covered) << "trial " << trial;
+        std::uint64_t want_passed = 0;
+        std::uint32_t want_pixels = 0;
         for (int j = 0; j < n; ++j) {
             ASSERT_EQ(samples[j], want_samples[j]) << "trial " << trial << " pixel " << j;
+            want_passed += static_cast<std::uint64_t>(__builtin_popcountll(want_samples[j]));
+            want_pixels |= static_cast<std::uint32_t>(want_samples[j] != 0) << j;
             for (int s = 0; s < S; ++s) {
                 const auto k = static_cast<std::size_t>(j * S + s);
                 ASSERT_EQ(bits(depth[k]), bits(want_depth[k]))
                     << "trial " << trial << " pixel " << j << " sample " << s;
+                if (!keep_tested || (want_covered_at[k] == 0)) continue;
+                ASSERT_EQ(bits(tested[k]), bits(want_tested[k]))
+                    << "trial " << trial << " pixel " << j << " sample " << s << " (tested depth)";
             }
         }
+        ASSERT_EQ(found.passed, want_passed) << "trial " << trial;
+        ASSERT_EQ(found.pixels, want_pixels) << "trial " << trial;
         ++rows;
         for (int j = 0; j < n; ++j) passed_samples += __builtin_popcountll(want_samples[j]);
     }
@@ -556,13 +571,13 @@ TEST(SampleRows, CoverageMasksFourSamplesPerVectorAreTheExactPerSampleTest) {
 }
 
 // box_coverage_avx2 (small triangles at one sample a pixel: a box of up to 8 pixels by up to a
-// tile's rows at once) against the exact test at each pixel's centre: all three integer edge
-// values ≥ 0. Boxes start left of and above the triangle and run past it; half the triangles'
+// tile's rows at once) and row_coverage_avx2 (MSAA rows' pixel centres: up to a tile's width)
+// against the exact test at each pixel's centre: all three integer edge values ≥ 0. Boxes start left of and above the triangle and run past it; half the triangles'
 // edges run through pixel centres (edge values of exactly 0 and −1 are common).
-TEST(SampleRows, BoxCoverageIsTheExactPerPixelTest) {
+TEST(SampleRows, BoxAndRowCoverageAreTheExactPerPixelTest) {
     if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2, which box_coverage_avx2 needs";
     std::mt19937_64 rng(64);
-    long boxes = 0, on_edges = 0, inside = 0, outside = 0;
+    long boxes = 0, on_edges = 0, inside = 0, outside = 0, row_inside = 0, row_outside = 0;
     for (int trial = 0; trial < 20000; ++trial) {
         mr::SetupTriangle t;
         if (!random_row_triangle(rng, trial, t)) continue;
@@ -596,14 +611,28 @@ TEST(SampleRows, BoxCoverageIsTheExactPerPixelTest) {
             outside += n - __builtin_popcount(want);
         }
         ASSERT_EQ(any, want_any) << "trial " << trial;
+        // row_coverage_avx2 along the box's first row, up to a tile's width.
+        const int length = 1 + static_cast<int>(rng() % mr::kTileSize);
+        std::uint32_t want_row = 0;
+        for (int j = 0; j < length; ++j) {
+            std::int64_t E[3];
+            for (int i = 0; i < 3; ++i) E[i] = first[i] + j * step_x[i];
+            if (E[0] >= 0 && E[1] >= 0 && E[2] >= 0) want_row |= 1u << j;
+        }
+        ASSERT_EQ(mr::kernels::row_coverage_avx2(first, step_x, length), want_row)
+            << "trial " << trial << ", " << length << " pixels";
+        row_inside += __builtin_popcount(want_row);
+        row_outside += length - __builtin_popcount(want_row);
         ++boxes;
     }
     std::cout << "boxes " << boxes << ", pixels on an edge " << on_edges << ", inside " << inside << ", outside "
-              << outside << "\n";
+              << outside << "; rows: inside " << row_inside << ", outside " << row_outside << "\n";
     EXPECT_GE(boxes, 15000);
     EXPECT_GE(on_edges, 200);
     EXPECT_GE(inside, 50000);
     EXPECT_GE(outside, 50000);
+    EXPECT_GE(row_inside, 50000);
+    EXPECT_GE(row_outside, 50000);
 }
 
 }  // namespace

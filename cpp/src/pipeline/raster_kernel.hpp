@@ -234,7 +234,8 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
                 float depths[kTileSize * kMaxSamples];  // (the write takes them, not computes them again)
                 const double* const by_sample[3] = {offsets[0], offsets[1], offsets[2]};
                 counters.samples_covered += test_pixel_row_avx2(t, row, n, by_sample, S, kDepth, false,
-                                                                target.depth.at(rx0, py, 0), samples, depths);
+                                                                target.depth.at(rx0, py, 0), samples, depths)
+                                                .covered;
                 for (int j = 0; j < n; ++j) {
                     if (!samples[j]) continue;
                     std::int64_t p[3];
@@ -484,30 +485,27 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         const auto msaa_row = [&](int rx0, int py, int n, const std::int64_t (&corner)[3]) {
             std::uint64_t samples[kTileSize];  // per pixel, the samples that passed
             const double* const offsets[3] = {offset0, offset1, offset2};
-            counters.samples_covered += test_pixel_row_avx2(t, corner, n, offsets, S, kDepth, draw.depth_write,
-                                                            depth_out.at(rx0, py, 0), samples);
-            std::uint32_t pixels = 0;
-            for (int j = 0; j < n; ++j) {
-                pixels |= static_cast<std::uint32_t>(samples[j] != 0) << j;
-                counters.samples_passed += static_cast<std::uint64_t>(count_bits(samples[j]));
-            }
+            const PixelRowTest found = test_pixel_row_avx2(t, corner, n, offsets, S, kDepth, draw.depth_write,
+                                                           depth_out.at(rx0, py, 0), samples);
+            counters.samples_covered += found.covered;
+            counters.samples_passed += found.passed;
+            const std::uint32_t pixels = found.pixels;
             if (!pixels) return;
             blocks.written_row(py, rx0, pixels);
             const std::int64_t centre[3] = {corner[0] + to_centre0, corner[1] + to_centre1, corner[2] + to_centre2};
+            const std::uint32_t centres = row_coverage_avx2(centre, {step0, step1, step2}, n);  // bit j: inside
             if constexpr (kShading == Shading::visibility) {
                 for (std::uint32_t m = pixels; m; m &= m - 1) {
                     const int j = __builtin_ctz(m);
-                    record_owner(rx0 + j, py, samples[j],
-                                 ((centre[0] + j * step0) | (centre[1] + j * step1) | (centre[2] + j * step2)) >= 0);
+                    record_owner(rx0 + j, py, samples[j], centres >> j & 1);
                 }
                 return;
             }
             counters.shader_invocations += static_cast<std::uint64_t>(count_bits(pixels));
             double l0[kTileSize], l1[kTileSize], l2[kTileSize];
             sample_row_weights(t, centre, n, l0, l1, l2);  // (exact: the centres lie within the row's pixels)
-            for (std::uint32_t m = pixels; m; m &= m - 1) {
+            for (std::uint32_t m = pixels & ~centres; m; m &= m - 1) {  // the others shade at a passed sample
                 const int j = __builtin_ctz(m);
-                if (((centre[0] + j * step0) | (centre[1] + j * step1) | (centre[2] + j * step2)) >= 0) continue;
                 const int s = __builtin_ctzll(samples[j]);
                 const glm::dvec3 l = screen_weights(t, corner[0] + j * step0 + off0[s], corner[1] + j * step1 + off1[s],
                                                     corner[2] + j * step2 + off2[s]);

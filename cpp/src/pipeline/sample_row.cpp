@@ -175,42 +175,59 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
     return true;
 }
 
-[[gnu::target("avx2")]] std::uint64_t test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&corner)[3],
-                                                          int n, const double* const (&offsets)[3], int S,
-                                                          DepthFunc func, bool depth_write, float* depth,
-                                                          std::uint64_t* samples, float* tested_depths) {
-    __m256d first[3], step[3], bias[3];
+[[gnu::target("avx2")]] PixelRowTest test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&corner)[3],
+                                                         int n, const double* const (&offsets)[3], int S,
+                                                         DepthFunc func, bool depth_write, float* depth,
+                                                         std::uint64_t* samples, float* tested_depths) {
+    __m256d pixel[3], step[3], bias[3];
     for (int i = 0; i < 3; ++i) {
-        first[i] = _mm256_set1_pd(static_cast<double>(corner[i] + t.bias[i]));
+        pixel[i] = _mm256_set1_pd(static_cast<double>(corner[i] + t.bias[i]));
         step[i] = _mm256_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
         bias[i] = _mm256_set1_pd(static_cast<double>(t.bias[i]));
     }
     const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2);
     const DepthPlane4 plane = depth_plane4(t);
-    std::uint64_t covered_samples = 0;
+    PixelRowTest found;
+    // Samples g … g + 3 of pixel j at edge values d (exact integers, bias added): the passed ones.
+    const auto four_samples = [&](const __m256d (&d)[3], int j, int g) -> std::uint32_t {
+        const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
+                                                           _mm256_cmp_pd(d[1], bias[1], _CMP_GE_OQ)),
+                                             _mm256_cmp_pd(d[2], bias[2], _CMP_GE_OQ));
+        const auto lanes = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
+        found.covered += static_cast<std::uint64_t>(__builtin_popcount(lanes));
+        if (!lanes) return 0;
+        const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
+        const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(j) * S + g;
+        return test_four_depths(plane, l1, l2, lanes, func, depth_write, depth + at,
+                                tested_depths ? tested_depths + at : nullptr);
+    };
+    const auto record = [&](int j, std::uint64_t passed) {
+        samples[j] = passed;
+        found.passed += static_cast<std::uint64_t>(__builtin_popcountll(passed));
+        found.pixels |= static_cast<std::uint32_t>(passed != 0) << j;
+    };
+    // The edge values move from pixel to pixel by adds: corner + bias + j·step + offset, exact
+    // integers (below 2^52), are the same doubles in any order of the sums.
+    if (S == 4) {  // (MSAA 4x) one vector a pixel, its samples' edge values stepped directly
+        __m256d d[3];
+        for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(pixel[i], _mm256_loadu_pd(offsets[i]));
+        for (int j = 0; j < n; ++j) {
+            record(j, four_samples(d, j, 0));
+            for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(d[i], step[i]);
+        }
+        return found;
+    }
     for (int j = 0; j < n; ++j) {
-        // The pixel's corner, e + bias + j·step: exact integers, as are the sums with the offsets.
-        const __m256d x = _mm256_set1_pd(static_cast<double>(j));
-        __m256d pixel[3];
-        for (int i = 0; i < 3; ++i) pixel[i] = _mm256_add_pd(first[i], _mm256_mul_pd(x, step[i]));
         std::uint64_t passed = 0;
         for (int g = 0; g < S; g += 4) {
             __m256d d[3];
             for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(pixel[i], _mm256_loadu_pd(offsets[i] + g));
-            const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
-                                                               _mm256_cmp_pd(d[1], bias[1], _CMP_GE_OQ)),
-                                                 _mm256_cmp_pd(d[2], bias[2], _CMP_GE_OQ));
-            const auto lanes = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
-            covered_samples += static_cast<std::uint64_t>(__builtin_popcount(lanes));
-            if (!lanes) continue;
-            const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
-            const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(j) * S + g;
-            float* const tested = tested_depths ? tested_depths + at : nullptr;
-            passed |= std::uint64_t{test_four_depths(plane, l1, l2, lanes, func, depth_write, depth + at, tested)} << g;
+            passed |= std::uint64_t{four_samples(d, j, g)} << g;
         }
-        samples[j] = passed;
+        record(j, passed);
+        for (int i = 0; i < 3; ++i) pixel[i] = _mm256_add_pd(pixel[i], step[i]);
     }
-    return covered_samples;
+    return found;
 }
 
 namespace {

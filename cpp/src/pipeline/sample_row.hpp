@@ -49,11 +49,16 @@ bool test_sample_row_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], in
 /// depth (less or greater) at the covered samples against depth[j·S + s], storing the passing
 /// depths when depth_write; samples[j] gets pixel j's passed samples. Where tested_depths is not
 /// null, tested_depths[j·S + s] gets the depth the test computed for each covered sample s (the
-/// others: unspecified). Returns how many samples are covered. The per-sample path's bits (as
+/// others: unspecified). Returns the counts of the row. The per-sample path's bits (as
 /// test_sample_row); needs AVX2.
-std::uint64_t test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&corner)[3], int n,
-                                  const double* const (&offsets)[3], int S, DepthFunc func, bool depth_write,
-                                  float* depth, std::uint64_t* samples, float* tested_depths = nullptr);
+struct PixelRowTest {
+    std::uint64_t covered = 0;  ///< samples inside the triangle
+    std::uint64_t passed = 0;   ///< samples that passed the depth test
+    std::uint32_t pixels = 0;   ///< bit j: pixel j has a passed sample (samples[j] != 0)
+};
+PixelRowTest test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&corner)[3], int n,
+                                 const double* const (&offsets)[3], int S, DepthFunc func, bool depth_write,
+                                 float* depth, std::uint64_t* samples, float* tested_depths = nullptr);
 
 /// The screen weights of pixels j < n of a row whose first pixel's sample has edge values e (bias
 /// not added), into l_i[j] (room for n rounded up to a multiple of 4): screen_weights' bits. False,
