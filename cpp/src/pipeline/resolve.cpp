@@ -6,7 +6,6 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
-#include <type_traits>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -50,6 +49,30 @@ inline void write_row(float* dst, int n, Pixel&& pixel) {
     }
 }
 
+// A pixel's sample at p in double (exact).
+inline RgbaDouble widen(const float* p) {
+#if defined(__AVX__)
+    return reinterpret_cast<RgbaDouble>(_mm256_cvtps_pd(_mm_loadu_ps(p)));  // (GCC split the generic one in four)
+#else
+    Rgba sample;
+    std::memcpy(&sample, p, sizeof sample);
+    return __builtin_convertvector(sample, RgbaDouble);
+#endif
+}
+
+// The mean of the S samples at p (kSamples: S known when compiling, the loop unrolled; else 0).
+// The sum in double: a float sum of samples near the float maximum would overflow to infinity,
+// though their mean is finite (all four channels in one vector: per channel the same additions,
+// from +0, in order). A power-of-two count divides by multiplying with its exact reciprocal
+// (kPowerOfTwo; the same bits): four double divisions a pixel were most of the resolve.
+template <int kSamples, bool kPowerOfTwo>
+inline Rgba sample_mean(const float* p, int S, double inverse) {
+    const int count = kSamples ? kSamples : S;
+    RgbaDouble sum{0, 0, 0, 0};
+    for (int s = 0; s < count; ++s) sum += widen(p + 4 * s);
+    return __builtin_convertvector(kPowerOfTwo ? sum * inverse : sum / double(count), Rgba);
+}
+
 // Orders the streaming stores before whatever the thread stores next (the pool's hand-off).
 inline void finish_rows() {
 #if defined(__SSE2__)
@@ -71,33 +94,19 @@ void resolve_tile(const SampleWindow& samples, int x0, int y0, int x1, int y1, R
             write_row(&out.at(x0, y, 0), x1 - x0, [&](int i) { return pixel(src + 4 * S * i); });
         }
     };
-    // A power-of-two count divides by multiplying with its exact reciprocal (the same bits): four
-    // double divisions a pixel were most of the resolve. One sample is its own mean: a copy.
-    const auto mean = [&](auto power_of_two) {
-        const double inverse = 1.0 / S;
-        return [&, inverse, power_of_two](const float* p) {
-            // The sum in double: a float sum of samples near the float maximum would overflow to
-            // infinity, though their mean is finite.
-            // (All four channels in one vector: per channel the same additions, from +0, in order.)
-            RgbaDouble sum{0, 0, 0, 0};
-            for (int s = 0; s < S; ++s) {
-                Rgba sample;
-                std::memcpy(&sample, p + 4 * s, sizeof sample);
-                sum += __builtin_convertvector(sample, RgbaDouble);
-            }
-            return __builtin_convertvector(power_of_two ? sum * inverse : sum / double(S), Rgba);
-        };
-    };
+    const double inverse = 1.0 / S;
     if (S == 1) {
         each_row([](const float* p) {
             Rgba v;
             std::memcpy(&v, p, sizeof v);
             return v;
         });
+    } else if (S == 4) {  // (MSAA and SSAA 4x: the sum unrolled)
+        each_row([inverse](const float* p) { return sample_mean<4, true>(p, 4, inverse); });
     } else if ((S & (S - 1)) == 0) {
-        each_row(mean(std::true_type{}));
+        each_row([S, inverse](const float* p) { return sample_mean<0, true>(p, S, inverse); });
     } else {
-        each_row(mean(std::false_type{}));
+        each_row([S, inverse](const float* p) { return sample_mean<0, false>(p, S, inverse); });
     }
     finish_rows();
 }
