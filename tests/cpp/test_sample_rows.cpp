@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <tuple>
@@ -633,6 +634,38 @@ TEST(SampleRows, BoxAndRowCoverageAreTheExactPerPixelTest) {
     EXPECT_GE(outside, 50000);
     EXPECT_GE(row_inside, 50000);
     EXPECT_GE(row_outside, 50000);
+}
+
+// sample_offsets_avx2 (each triangle's sample offsets under MSAA and SSAA, four per vector) against
+// the scalar int64 products a·x + b·y, with edge coefficients over the whole int32 range (their
+// extremes included) and offsets anywhere in a pixel's 256 subpixel steps.
+TEST(SampleRows, SampleOffsetsFourPerVectorAreTheScalarProducts) {
+    if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2, which sample_offsets_avx2 needs";
+    std::mt19937_64 rng(65);
+    constexpr std::int32_t kExtremes[] = {std::numeric_limits<std::int32_t>::min(),
+                                          std::numeric_limits<std::int32_t>::max(), -1, 0, 1};
+    long checked = 0;
+    for (int trial = 0; trial < 5000; ++trial) {
+        mr::SetupTriangle t;
+        for (int e = 0; e < 3; ++e) {
+            t.edge_a[e] = trial % 4 == 0 ? kExtremes[rng() % 5] : static_cast<std::int32_t>(rng());
+            t.edge_b[e] = trial % 4 == 1 ? kExtremes[rng() % 5] : static_cast<std::int32_t>(rng());
+        }
+        const int S = std::array<int, 4>{4, 8, 16, 64}[trial % 4];
+        std::vector<std::int32_t> x(static_cast<std::size_t>(S)), y(x.size());
+        for (int s = 0; s < S; ++s)
+            x[static_cast<std::size_t>(s)] = static_cast<std::int32_t>(rng() % 256),
+            y[static_cast<std::size_t>(s)] = static_cast<std::int32_t>(rng() % 256);
+        std::int64_t off[3][64];
+        mr::kernels::sample_offsets_avx2(t, x.data(), y.data(), S, {off[0], off[1], off[2]});
+        for (int e = 0; e < 3; ++e)
+            for (int s = 0; s < S; ++s, ++checked)
+                ASSERT_EQ(off[e][s], std::int64_t{t.edge_a[e]} * x[static_cast<std::size_t>(s)] +
+                                         std::int64_t{t.edge_b[e]} * y[static_cast<std::size_t>(s)])
+                    << "trial " << trial << " edge " << e << " sample " << s;
+    }
+    std::cout << "offsets checked " << checked << "\n";
+    EXPECT_GE(checked, 100000);
 }
 
 }  // namespace

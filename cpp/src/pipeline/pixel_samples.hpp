@@ -88,6 +88,27 @@ struct DepthPlane4 {
     return true;
 }
 
+/// The edge offsets of samples s < S (a multiple of 4) from their pixel's corner, off[e][s] =
+/// a_e·x[s] + b_e·y[s], four samples per int64 vector: the 32-bit factors' products in 64 bits,
+/// the scalar products exactly. Per triangle and tile; the scalar loop was 5 % of many_small's SSAA
+/// 4x frame (its triangles cover a pixel or two). Needs AVX2.
+#if defined(__AVX2__)
+[[gnu::always_inline]]
+#endif
+[[gnu::target("avx2")]] inline void sample_offsets_avx2(const SetupTriangle& t, const std::int32_t* x,
+                                                        const std::int32_t* y, int S,
+                                                        std::int64_t* const (&off)[3]) {
+    for (int g = 0; g < S; g += 4) {
+        const __m256i ox = _mm256_cvtepi32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(x + g)));
+        const __m256i oy = _mm256_cvtepi32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(y + g)));
+        for (int e = 0; e < 3; ++e) {
+            const __m256i a = _mm256_set1_epi64x(t.edge_a[e]), b = _mm256_set1_epi64x(t.edge_b[e]);
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(off[e] + g),
+                                _mm256_add_epi64(_mm256_mul_epi32(a, ox), _mm256_mul_epi32(b, oy)));
+        }
+    }
+}
+
 /// Coverage masks of a row of n pixels: bit s of mask[j] is set when sample s of pixel j is
 /// inside, i.e. all three edge values row[e] + off[e][s] + j·step[e] are ≥ 0 (the sign bit of
 /// their OR is clear). Four samples per int64 vector, the scalar loop's integer sums exactly;

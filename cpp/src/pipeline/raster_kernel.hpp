@@ -389,10 +389,14 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
 
         // Edge offsets of each sample from its pixel's corner: a·ox + b·oy.
         std::int64_t off0[kMaxSamples], off1[kMaxSamples], off2[kMaxSamples];
-        for (int s = 0; s < S; ++s) {
-            off0[s] = std::int64_t{t.edge_a[0]} * pattern.x[s] + std::int64_t{t.edge_b[0]} * pattern.y[s];
-            off1[s] = std::int64_t{t.edge_a[1]} * pattern.x[s] + std::int64_t{t.edge_b[1]} * pattern.y[s];
-            off2[s] = std::int64_t{t.edge_a[2]} * pattern.x[s] + std::int64_t{t.edge_b[2]} * pattern.y[s];
+        if (vector_masks) {
+            sample_offsets_avx2(t, pattern.x.data(), pattern.y.data(), S, {off0, off1, off2});
+        } else {
+            for (int s = 0; s < S; ++s) {
+                off0[s] = std::int64_t{t.edge_a[0]} * pattern.x[s] + std::int64_t{t.edge_b[0]} * pattern.y[s];
+                off1[s] = std::int64_t{t.edge_a[1]} * pattern.x[s] + std::int64_t{t.edge_b[1]} * pattern.y[s];
+                off2[s] = std::int64_t{t.edge_a[2]} * pattern.x[s] + std::int64_t{t.edge_b[2]} * pattern.y[s];
+            }
         }
         const std::int64_t step0 = t.edge_a[0] * kStep, step1 = t.edge_a[1] * kStep, step2 = t.edge_a[2] * kStep;
         // Edge offsets of a pixel's centre from its corner (MSAA shades there when it is inside).
