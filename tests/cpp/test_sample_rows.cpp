@@ -573,8 +573,9 @@ TEST(SampleRows, CoverageMasksFourSamplesPerVectorAreTheExactPerSampleTest) {
 
 // box_coverage_avx2 (small triangles at one sample a pixel: a box of up to 8 pixels by up to a
 // tile's rows at once) and row_coverage_avx2 (MSAA rows' pixel centres: up to a tile's width)
-// against the exact test at each pixel's centre: all three integer edge values ≥ 0. Boxes start left of and above the triangle and run past it; half the triangles'
-// edges run through pixel centres (edge values of exactly 0 and −1 are common).
+// against the exact test at each pixel's centre: all three integer edge values ≥ 0. Boxes start
+// left of and above the triangle and run past it; half the triangles' edges run through pixel
+// centres (edge values of exactly 0 and −1 are common).
 TEST(SampleRows, BoxAndRowCoverageAreTheExactPerPixelTest) {
     if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2, which box_coverage_avx2 needs";
     std::mt19937_64 rng(64);

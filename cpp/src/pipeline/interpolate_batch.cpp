@@ -157,10 +157,13 @@ template <bool kScaled>  // the derivatives times footprint_scale (interpolate_g
     if (quotient_rule_only(draw, shading, texturing)) {
         const QuotientTerms k(t, *uvs);
         const glm::dvec2 scale = draw.footprint_scale;
-        if (scale == glm::dvec2(1.0))
-            for (int first = 0; first < w.count; first += kWidth) quotient_rule_group<false>(k, scale, w, first, lookups);
-        else
-            for (int first = 0; first < w.count; first += kWidth) quotient_rule_group<true>(k, scale, w, first, lookups);
+        if (scale == glm::dvec2(1.0)) {
+            for (int first = 0; first < w.count; first += kWidth)
+                quotient_rule_group<false>(k, scale, w, first, lookups);
+        } else {
+            for (int first = 0; first < w.count; first += kWidth)
+                quotient_rule_group<true>(k, scale, w, first, lookups);
+        }
     } else {
         for (int first = 0; first < w.count; first += kWidth)
             interpolate_group(draw, shading, texturing, t, colors, uvs, w, first, channels, lookups);

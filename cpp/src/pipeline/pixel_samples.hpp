@@ -192,10 +192,10 @@ struct DepthPlane4 {
     return any;
 }
 
-/// The coverage of n ≤ kTileSize points along a row, one a pixel: bit j is set when all three edge
-/// values first[e] + j·step[e] are ≥ 0. Four pixels per int64 vector, the integer test exactly (MSAA
-/// rows ask it of their pixels' centres: tested pixel by pixel, with a row's multiplies, it was 4 %
-/// of the plane's MSAA 4x frame). Needs AVX2.
+/// The coverage of n ≤ kTileSize points along a row, one a pixel: bit j is set when all three
+/// edge values first[e] + j·step[e] are ≥ 0. Four pixels per int64 vector, the integer test
+/// exactly (MSAA rows ask it of their pixels' centres: tested pixel by pixel, with a row's
+/// multiplies, it was 4 % of the plane's MSAA 4x frame). Needs AVX2.
 #if defined(__AVX2__)
 [[gnu::always_inline]]
 #endif

@@ -175,6 +175,28 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
     return true;
 }
 
+namespace {
+
+// test_pixel_row_avx2's step for four samples of a pixel at edge values d (exact integers, bias
+// added): `covered` counts those inside; their depth test against depth[at … at + 3] (the
+// computed depths into tested[at … at + 3] where it is not null). Returns the passed ones. (A
+// function, not a lambda: a lambda does not take its function's target, and a baseline build
+// could not inline the intrinsics into it.)
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline std::uint32_t four_samples(
+    const __m256d (&d)[3], const __m256d (&bias)[3], __m256d inv_area2, const DepthPlane4& plane, DepthFunc func,
+    bool depth_write, float* depth, float* tested, std::ptrdiff_t at, std::uint64_t& covered) {
+    const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
+                                                       _mm256_cmp_pd(d[1], bias[1], _CMP_GE_OQ)),
+                                         _mm256_cmp_pd(d[2], bias[2], _CMP_GE_OQ));
+    const auto lanes = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
+    covered += static_cast<std::uint64_t>(__builtin_popcount(lanes));
+    if (!lanes) return 0;
+    const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
+    return test_four_depths(plane, l1, l2, lanes, func, depth_write, depth + at, tested ? tested + at : nullptr);
+}
+
+}  // namespace
+
 [[gnu::target("avx2")]] PixelRowTest test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&corner)[3],
                                                          int n, const double* const (&offsets)[3], int S,
                                                          DepthFunc func, bool depth_write, float* depth,
@@ -188,19 +210,6 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
     const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2);
     const DepthPlane4 plane = depth_plane4(t);
     PixelRowTest found;
-    // Samples g … g + 3 of pixel j at edge values d (exact integers, bias added): the passed ones.
-    const auto four_samples = [&](const __m256d (&d)[3], int j, int g) -> std::uint32_t {
-        const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
-                                                           _mm256_cmp_pd(d[1], bias[1], _CMP_GE_OQ)),
-                                             _mm256_cmp_pd(d[2], bias[2], _CMP_GE_OQ));
-        const auto lanes = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
-        found.covered += static_cast<std::uint64_t>(__builtin_popcount(lanes));
-        if (!lanes) return 0;
-        const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
-        const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(j) * S + g;
-        return test_four_depths(plane, l1, l2, lanes, func, depth_write, depth + at,
-                                tested_depths ? tested_depths + at : nullptr);
-    };
     const auto record = [&](int j, std::uint64_t passed) {
         samples[j] = passed;
         found.passed += static_cast<std::uint64_t>(__builtin_popcountll(passed));
@@ -212,7 +221,8 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         __m256d d[3];
         for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(pixel[i], _mm256_loadu_pd(offsets[i]));
         for (int j = 0; j < n; ++j) {
-            record(j, four_samples(d, j, 0));
+            record(j, four_samples(d, bias, inv_area2, plane, func, depth_write, depth, tested_depths, 4 * j,
+                                   found.covered));
             for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(d[i], step[i]);
         }
         return found;
@@ -222,7 +232,10 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         for (int g = 0; g < S; g += 4) {
             __m256d d[3];
             for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(pixel[i], _mm256_loadu_pd(offsets[i] + g));
-            passed |= std::uint64_t{four_samples(d, j, g)} << g;
+            const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(j) * S + g;
+            passed |= std::uint64_t{four_samples(d, bias, inv_area2, plane, func, depth_write, depth, tested_depths,
+                                                 at, found.covered)}
+                      << g;
         }
         record(j, passed);
         for (int i = 0; i < 3; ++i) pixel[i] = _mm256_add_pd(pixel[i], step[i]);
