@@ -424,6 +424,87 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
 // test_pixel_row_avx2 (MSAA rows, a pixel's samples four per vector) against the per-sample
 // arithmetic: coverage from the exact integer edge values, sample_depth(screen_weights(...)) for the
 // test, ties failing. Sample 0 is the pixel centre, through which half the triangles' edges run.
+// SSAA's four samples a pixel at once (test_four_sample_rows_avx2, depths side by side) against
+// four rows of the SSE2 path (checked against the per-sample arithmetic above), one per sample, on
+// the same depths: the same refusals, masks, weights and every depth bit.
+TEST(SampleRows, FourSampleRowsAreFourSingleSampleRows) {
+    if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2";
+    std::mt19937_64 rng(62);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    long rows = 0, refused = 0, passed_samples = 0, partly_passed = 0;
+    for (int trial = 0; trial < 12000; ++trial) {
+        mr::SetupTriangle t;
+        if (!random_row_triangle(rng, trial, t)) continue;
+        const int y = t.min_y + static_cast<int>(rng() % static_cast<unsigned>(t.max_y - t.min_y + 1));
+        const int x0 = t.min_x - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_x - t.min_x + 3));
+        const int n = 1 + static_cast<int>(rng() % mr::kTileSize);
+        std::int64_t e[4][3];
+        for (int s = 0; s < 4; ++s) {
+            const std::int64_t X = std::int64_t{x0} * mr::kSubpixelOne + static_cast<std::int64_t>(rng() % 256);
+            const std::int64_t Y = std::int64_t{y} * mr::kSubpixelOne + static_cast<std::int64_t>(rng() % 256);
+            for (int i = 0; i < 3; ++i) e[s][i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+        }
+        if (trial % 40 == 0) e[trial % 4][trial % 3] += std::int64_t{1} << 52;  // one sample's row refused
+        const std::uint32_t tested = static_cast<std::uint32_t>(rng());
+        const mr::DepthFunc func = rng() % 2 ? mr::DepthFunc::greater : mr::DepthFunc::less;
+        const bool depth_write = rng() % 2;
+        std::vector<float> depth(static_cast<std::size_t>(4 * n) + 4, -1.0f);  // (one pixel past the row)
+        for (int k = 0; k < 4 * n; ++k) {
+            const int kind = static_cast<int>(rng() % 3);
+            depth[static_cast<std::size_t>(k)] = kind == 0 ? float(unit(rng)) : kind == 1 ? 0.0f : 1.0f;
+        }
+        // Ties: some stored depths are the sample's own.
+        for (int j = 0; j < n; ++j)
+            for (int s = 0; s < 4; ++s)
+                if (rng() % 4 == 0) {
+                    const glm::dvec3 l = mr::screen_weights(t, e[s][0] + std::int64_t{t.edge_a[0]} * mr::kSubpixelOne * j,
+                                                            e[s][1] + std::int64_t{t.edge_a[1]} * mr::kSubpixelOne * j,
+                                                            e[s][2] + std::int64_t{t.edge_a[2]} * mr::kSubpixelOne * j);
+                    depth[static_cast<std::size_t>(4 * j + s)] = mr::sample_depth(t, l);
+                }
+        std::vector<float> want_depth = depth;
+        mr::kernels::SampleRow want[4], got[4];
+        std::vector<float> scratch = depth;
+        bool each_ran = true;
+        for (int s = 0; s < 4; ++s)
+            each_ran = mr::kernels::test_sample_row_sse2(t, e[s], n, tested, func, depth_write,
+                                                         scratch.data() + s, 4, want[s]) && each_ran;
+        if (each_ran) want_depth = scratch;
+        for (mr::kernels::SampleRow& row : got)
+            for (double* l : {row.l0, row.l1, row.l2}) std::fill(l, l + mr::kTileSize, std::nan(""));
+        std::vector<float> got_depth = depth;
+        const bool ran =
+            mr::kernels::test_four_sample_rows_avx2(t, e, n, tested, func, depth_write, got_depth.data(), got);
+        ASSERT_EQ(ran, each_ran) << "trial " << trial;
+        for (std::size_t k = 0; k < depth.size(); ++k)
+            ASSERT_EQ(bits(got_depth[k]), bits(ran ? want_depth[k] : depth[k])) << "trial " << trial << " depth " << k;
+        ++rows;
+        if (!ran) {
+            ++refused;
+            continue;
+        }
+        int samples = 0;
+        for (int s = 0; s < 4; ++s) {
+            ASSERT_EQ(got[s].covered, want[s].covered) << "trial " << trial << " sample " << s;
+            ASSERT_EQ(got[s].passed, want[s].passed) << "trial " << trial << " sample " << s;
+            for (int j = 0; j < n; ++j) {
+                if (!(want[s].passed >> j & 1)) continue;
+                ASSERT_EQ(bits(got[s].l0[j]), bits(want[s].l0[j])) << "trial " << trial << " sample " << s;
+                ASSERT_EQ(bits(got[s].l1[j]), bits(want[s].l1[j])) << "trial " << trial << " sample " << s;
+                ASSERT_EQ(bits(got[s].l2[j]), bits(want[s].l2[j])) << "trial " << trial << " sample " << s;
+            }
+            samples += __builtin_popcount(want[s].passed);
+        }
+        passed_samples += samples;
+        partly_passed += samples > 0 && samples < 4 * n;
+    }
+    std::cout << "rows " << rows << " (refused " << refused << "), passed samples " << passed_samples
+              << ", rows partly passed " << partly_passed << "\n";
+    EXPECT_GE(rows, 8000);
+    EXPECT_GE(refused, 100);
+    EXPECT_GE(partly_passed, 2000);
+}
+
 TEST(SampleRows, PixelRowsGiveThePerSampleArithmeticOnRandomRows) {
     if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2, which test_pixel_row_avx2 needs";
     std::mt19937_64 rng(62);

@@ -175,6 +175,75 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
     return true;
 }
 
+// test_sample_row_avx2 for samples 0 … 3 at once: per sample the same operations; the depths of
+// four pixels are read and written as four vectors of a pixel's samples, transposed in registers.
+[[gnu::target("avx2")]] bool test_four_sample_rows_avx2(const SetupTriangle& t, const std::int64_t (&e)[4][3], int n,
+                                                        std::uint32_t tested, DepthFunc func, bool depth_write,
+                                                        float* depth, SampleRow (&out)[4]) {
+    for (int s = 0; s < 4; ++s)
+        if (!exact_row(t, e[s], n)) return false;
+    __m256d first[4][3], step[3], bias[3];
+    for (int i = 0; i < 3; ++i) {
+        step[i] = _mm256_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
+        bias[i] = _mm256_set1_pd(static_cast<double>(t.bias[i]));
+        for (int s = 0; s < 4; ++s) first[s][i] = _mm256_set1_pd(static_cast<double>(e[s][i] + t.bias[i]));
+    }
+    const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2), z0 = _mm256_set1_pd(t.z0), dz1 = _mm256_set1_pd(t.dz1),
+                  dz2 = _mm256_set1_pd(t.dz2);
+    const bool greater = func == DepthFunc::greater;
+    for (SampleRow& row : out) row.covered = row.passed = 0;
+    const __m256d four = _mm256_set1_pd(4.0);
+    __m256d x = _mm256_set_pd(3.0, 2.0, 1.0, 0.0);
+    for (int j = 0; j < n; j += 4, x = _mm256_add_pd(x, four)) {
+        const int lanes = n - j < 4 ? n - j : 4;
+        const std::uint32_t in_row = (1u << lanes) - 1u;
+        __m256d l0[4], l1[4], l2[4];
+        __m128 depths[4];
+        std::uint32_t asked[4], any_asked = 0;
+        for (int s = 0; s < 4; ++s) {
+            __m256d d[3];
+            for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(first[s][i], _mm256_mul_pd(x, step[i]));
+            const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
+                                                               _mm256_cmp_pd(d[1], bias[1], _CMP_GE_OQ)),
+                                                 _mm256_cmp_pd(d[2], bias[2], _CMP_GE_OQ));
+            l0[s] = _mm256_mul_pd(d[0], inv_area2), l1[s] = _mm256_mul_pd(d[1], inv_area2),
+            l2[s] = _mm256_mul_pd(d[2], inv_area2);
+            depths[s] = _mm256_cvtpd_ps(
+                _mm256_add_pd(_mm256_add_pd(z0, _mm256_mul_pd(l1[s], dz1)), _mm256_mul_pd(l2[s], dz2)));
+            const std::uint32_t covered = static_cast<std::uint32_t>(_mm256_movemask_pd(inside)) & in_row;
+            out[s].covered |= covered << j;
+            asked[s] = covered & (tested >> j);
+            any_asked |= asked[s];
+        }
+        if (!any_asked) continue;
+        // stored[p]: pixel p's four samples; after the transpose, stored[s]: sample s of the pixels.
+        float* const pixels = depth + 4 * j;
+        __m128 stored[4];
+        for (int p = 0; p < 4; ++p) stored[p] = p < lanes ? _mm_loadu_ps(pixels + 4 * p) : _mm_setzero_ps();
+        _MM_TRANSPOSE4_PS(stored[0], stored[1], stored[2], stored[3]);
+        bool wrote = false;
+        for (int s = 0; s < 4; ++s) {
+            const __m128 wins = greater ? _mm_cmpgt_ps(depths[s], stored[s]) : _mm_cmplt_ps(depths[s], stored[s]);
+            const std::uint32_t passed = static_cast<std::uint32_t>(_mm_movemask_ps(wins)) & asked[s];
+            if (!passed) continue;
+            out[s].passed |= passed << j;
+            _mm256_storeu_pd(out[s].l0 + j, l0[s]);
+            _mm256_storeu_pd(out[s].l1 + j, l1[s]);
+            _mm256_storeu_pd(out[s].l2 + j, l2[s]);
+            if (!depth_write) continue;
+            const __m128 passing = _mm_castsi128_ps(_mm_cmpgt_epi32(
+                _mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(passed)), _mm_setr_epi32(1, 2, 4, 8)),
+                _mm_setzero_si128()));
+            stored[s] = _mm_blendv_ps(stored[s], depths[s], passing);
+            wrote = true;
+        }
+        if (!wrote) continue;
+        _MM_TRANSPOSE4_PS(stored[0], stored[1], stored[2], stored[3]);
+        for (int p = 0; p < lanes; ++p) _mm_storeu_ps(pixels + 4 * p, stored[p]);
+    }
+    return true;
+}
+
 namespace {
 
 // test_pixel_row_avx2's step for four samples of a pixel at edge values d (exact integers, bias
