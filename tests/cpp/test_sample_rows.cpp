@@ -69,6 +69,7 @@ TEST(SampleRows, SameBitsAndCountersAsThePerSamplePathOnOverlappingScenes) {
                          {std::tuple{1, mr::PatternKind::automatic, mr::AntiAliasing::ssaa},
                           std::tuple{4, mr::PatternKind::rotated, mr::AntiAliasing::ssaa},
                           std::tuple{6, mr::PatternKind::stratified, mr::AntiAliasing::ssaa},
+                          std::tuple{8, mr::PatternKind::grid, mr::AntiAliasing::ssaa},
                           std::tuple{4, mr::PatternKind::rotated, mr::AntiAliasing::msaa},
                           std::tuple{8, mr::PatternKind::stratified, mr::AntiAliasing::msaa},
                           std::tuple{6, mr::PatternKind::stratified, mr::AntiAliasing::msaa}}) {
@@ -424,9 +425,10 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
 // test_pixel_row_avx2 (MSAA rows, a pixel's samples four per vector) against the per-sample
 // arithmetic: coverage from the exact integer edge values, sample_depth(screen_weights(...)) for the
 // test, ties failing. Sample 0 is the pixel centre, through which half the triangles' edges run.
-// SSAA's four samples a pixel at once (test_four_sample_rows_avx2, depths side by side) against
-// four rows of the SSE2 path (checked against the per-sample arithmetic above), one per sample, on
-// the same depths: the same refusals, masks, weights and every depth bit.
+// SSAA's samples four at a time (test_four_sample_rows_avx2: four of a pixel's 4, 8 or 16 depths side
+// by side) against four rows of the SSE2 path (checked against the per-sample arithmetic above), one
+// per sample, on the same depths: the same refusals, masks, weights and every depth bit, the
+// pixel's other samples and the next pixel untouched.
 TEST(SampleRows, FourSampleRowsAreFourSingleSampleRows) {
     if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2";
     std::mt19937_64 rng(62);
@@ -448,11 +450,15 @@ TEST(SampleRows, FourSampleRowsAreFourSingleSampleRows) {
         const std::uint32_t tested = static_cast<std::uint32_t>(rng());
         const mr::DepthFunc func = rng() % 2 ? mr::DepthFunc::greater : mr::DepthFunc::less;
         const bool depth_write = rng() % 2;
-        std::vector<float> depth(static_cast<std::size_t>(4 * n) + 4, -1.0f);  // (one pixel past the row)
-        for (int k = 0; k < 4 * n; ++k) {
-            const int kind = static_cast<int>(rng() % 3);
-            depth[static_cast<std::size_t>(k)] = kind == 0 ? float(unit(rng)) : kind == 1 ? 0.0f : 1.0f;
-        }
+        const int stride = std::array<int, 3>{4, 8, 16}[trial % 3];     // the pixel's samples
+        const int first = 4 * static_cast<int>(rng() % static_cast<unsigned>(stride / 4));  // the four's first
+        std::vector<float> depth(static_cast<std::size_t>((n + 1) * stride), -1.0f);  // (one pixel past the row)
+        for (int j = 0; j < n; ++j)
+            for (int s = 0; s < 4; ++s) {
+                const int kind = static_cast<int>(rng() % 3);
+                depth[static_cast<std::size_t>(j * stride + first + s)] =
+                    kind == 0 ? float(unit(rng)) : kind == 1 ? 0.0f : 1.0f;
+            }
         // Ties: some stored depths are the sample's own.
         for (int j = 0; j < n; ++j)
             for (int s = 0; s < 4; ++s)
@@ -460,7 +466,7 @@ TEST(SampleRows, FourSampleRowsAreFourSingleSampleRows) {
                     const glm::dvec3 l = mr::screen_weights(t, e[s][0] + std::int64_t{t.edge_a[0]} * mr::kSubpixelOne * j,
                                                             e[s][1] + std::int64_t{t.edge_a[1]} * mr::kSubpixelOne * j,
                                                             e[s][2] + std::int64_t{t.edge_a[2]} * mr::kSubpixelOne * j);
-                    depth[static_cast<std::size_t>(4 * j + s)] = mr::sample_depth(t, l);
+                    depth[static_cast<std::size_t>(j * stride + first + s)] = mr::sample_depth(t, l);
                 }
         std::vector<float> want_depth = depth;
         mr::kernels::SampleRow want[4], got[4];
@@ -468,13 +474,13 @@ TEST(SampleRows, FourSampleRowsAreFourSingleSampleRows) {
         bool each_ran = true;
         for (int s = 0; s < 4; ++s)
             each_ran = mr::kernels::test_sample_row_sse2(t, e[s], n, tested, func, depth_write,
-                                                         scratch.data() + s, 4, want[s]) && each_ran;
+                                                         scratch.data() + first + s, stride, want[s]) && each_ran;
         if (each_ran) want_depth = scratch;
         for (mr::kernels::SampleRow& row : got)
             for (double* l : {row.l0, row.l1, row.l2}) std::fill(l, l + mr::kTileSize, std::nan(""));
         std::vector<float> got_depth = depth;
-        const bool ran =
-            mr::kernels::test_four_sample_rows_avx2(t, e, n, tested, func, depth_write, got_depth.data(), got);
+        const bool ran = mr::kernels::test_four_sample_rows_avx2(t, e, n, tested, func, depth_write,
+                                                                 got_depth.data() + first, stride, got);
         ASSERT_EQ(ran, each_ran) << "trial " << trial;
         for (std::size_t k = 0; k < depth.size(); ++k)
             ASSERT_EQ(bits(got_depth[k]), bits(ran ? want_depth[k] : depth[k])) << "trial " << trial << " depth " << k;

@@ -585,26 +585,29 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 if (rows) {
                     const std::uint32_t skipped = blocks.row_pixels(cls.skipped, py, rx0, n);
                     const std::uint32_t untested = skipped | blocks.row_pixels(cls.hidden, py, rx0, n);
-                    // Four samples a pixel with AVX2: their rows at once, the depths four pixels a vector.
+                    // A multiple of four samples with AVX2: four rows at once, their depths four pixels
+                    // a vector. (No row is refused past sample 0: sample_rows_exact holds.)
                     SampleRow four[4];
-                    const bool fours = kMode == SampleMode::ssaa && S == 4 && vector_masks;
-                    if (fours) {
-                        const std::int64_t e[4][3] = {{row0 + off0[0], row1 + off1[0], row2 + off2[0]},
-                                                      {row0 + off0[1], row1 + off1[1], row2 + off2[1]},
-                                                      {row0 + off0[2], row1 + off1[2], row2 + off2[2]},
-                                                      {row0 + off0[3], row1 + off1[3], row2 + off2[3]}};
-                        rows = test_four_sample_rows_avx2(t, e, n, ~untested, kDepth, draw.depth_write,
-                                                          depth_out.at(rx0, py, 0), four);
-                    }
+                    const bool fours = kMode == SampleMode::ssaa && vector_masks;
                     for (int s = 0; rows && s < S; ++s) {
                         SampleRow single_row;
+                        if (fours && s % 4 == 0) {
+                            std::int64_t e[4][3];
+                            for (int k = 0; k < 4; ++k)
+                                e[k][0] = row0 + off0[s + k], e[k][1] = row1 + off1[s + k], e[k][2] = row2 + off2[s + k];
+                            if (!test_four_sample_rows_avx2(t, e, n, ~untested, kDepth, draw.depth_write,
+                                                            depth_out.at(rx0, py, s), S, four)) {
+                                rows = false;
+                                break;
+                            }
+                        }
                         const std::int64_t e[3] = {row0 + off0[s], row1 + off1[s], row2 + off2[s]};
                         if (!fours && !test_sample_row(t, e, n, ~untested, kDepth, draw.depth_write,
                                                        depth_out.at(rx0, py, s), S, single_row)) {
                             rows = false;  // (one sample, nothing done yet)
                             break;
                         }
-                        const SampleRow& row = fours ? four[s] : single_row;
+                        const SampleRow& row = fours ? four[s % 4] : single_row;
                         counters.samples_covered += static_cast<std::uint64_t>(count_bits(row.covered & ~skipped));
                         if constexpr (kShading == Shading::visibility || kTexturing != Texturing::none || kColours)
                             if (passed_row(rx0, py, s, row)) continue;

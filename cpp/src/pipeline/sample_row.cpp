@@ -175,11 +175,11 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
     return true;
 }
 
-// test_sample_row_avx2 for samples 0 … 3 at once: per sample the same operations; the depths of
-// four pixels are read and written as four vectors of a pixel's samples, transposed in registers.
+// test_sample_row_avx2 for four samples at once: per sample the same operations; the depths of
+// four pixels are read and written as four vectors of four samples, transposed in registers.
 [[gnu::target("avx2")]] bool test_four_sample_rows_avx2(const SetupTriangle& t, const std::int64_t (&e)[4][3], int n,
                                                         std::uint32_t tested, DepthFunc func, bool depth_write,
-                                                        float* depth, SampleRow (&out)[4]) {
+                                                        float* depth, int stride, SampleRow (&out)[4]) {
     for (int s = 0; s < 4; ++s)
         if (!exact_row(t, e[s], n)) return false;
     __m256d first[4][3], step[3], bias[3];
@@ -217,9 +217,9 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         }
         if (!any_asked) continue;
         // stored[p]: pixel p's four samples; after the transpose, stored[s]: sample s of the pixels.
-        float* const pixels = depth + 4 * j;
+        float* const pixels = depth + static_cast<std::ptrdiff_t>(j) * stride;
         __m128 stored[4];
-        for (int p = 0; p < 4; ++p) stored[p] = p < lanes ? _mm_loadu_ps(pixels + 4 * p) : _mm_setzero_ps();
+        for (int p = 0; p < 4; ++p) stored[p] = p < lanes ? _mm_loadu_ps(pixels + p * stride) : _mm_setzero_ps();
         _MM_TRANSPOSE4_PS(stored[0], stored[1], stored[2], stored[3]);
         bool wrote = false;
         for (int s = 0; s < 4; ++s) {
@@ -239,7 +239,7 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         }
         if (!wrote) continue;
         _MM_TRANSPOSE4_PS(stored[0], stored[1], stored[2], stored[3]);
-        for (int p = 0; p < lanes; ++p) _mm_storeu_ps(pixels + 4 * p, stored[p]);
+        for (int p = 0; p < lanes; ++p) _mm_storeu_ps(pixels + p * stride, stored[p]);
     }
     return true;
 }

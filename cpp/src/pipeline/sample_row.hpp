@@ -43,11 +43,12 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
 bool test_sample_row_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested,
                           DepthFunc func, bool depth_write, float* depth, int stride, SampleRow& out);
 
-/// test_sample_row for samples 0 … 3 of a pixel whose depths lie side by side (stride 4), sample s's
-/// edge values at the first pixel e[s]: out[s] gets sample s's row, the same bits as four calls.
-/// Returns false, touching nothing, where one of those calls would. Needs AVX2.
+/// test_sample_row for four samples of a pixel whose depths lie side by side (depth[j·stride + k]
+/// for sample k of pixel j, stride a multiple of 4), sample k's edge values at the first pixel
+/// e[k]: out[k] gets sample k's row, the same bits as four calls. Returns false, touching nothing,
+/// where one of those calls would. Needs AVX2.
 bool test_four_sample_rows_avx2(const SetupTriangle& t, const std::int64_t (&e)[4][3], int n, std::uint32_t tested,
-                                DepthFunc func, bool depth_write, float* depth, SampleRow (&out)[4]);
+                                DepthFunc func, bool depth_write, float* depth, int stride, SampleRow (&out)[4]);
 
 /// Triangle t over every sample of pixels j < n of a row under MSAA, whose first pixel's corner has
 /// edge values `corner` (bias not added; sample_rows_exact must hold), a pixel's S samples (a
