@@ -425,10 +425,10 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
 // test_pixel_row_avx2 (MSAA rows, a pixel's samples four per vector) against the per-sample
 // arithmetic: coverage from the exact integer edge values, sample_depth(screen_weights(...)) for the
 // test, ties failing. Sample 0 is the pixel centre, through which half the triangles' edges run.
-// SSAA's samples four at a time (test_four_sample_rows_avx2: four of a pixel's 4, 8 or 16 depths side
-// by side) against four rows of the SSE2 path (checked against the per-sample arithmetic above), one
-// per sample, on the same depths: the same refusals, masks, weights and every depth bit, the
-// pixel's other samples and the next pixel untouched.
+// SSAA's samples four at a time (test_four_sample_rows_avx2: four of a pixel's 4, 8 or 16
+// depths side by side) against four rows of the SSE2 path (checked against the per-sample
+// arithmetic above), one per sample, on the same depths: the same refusals, masks, weights and
+// every depth bit, the pixel's other samples and the next pixel untouched.
 TEST(SampleRows, FourSampleRowsAreFourSingleSampleRows) {
     if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2";
     std::mt19937_64 rng(62);
@@ -463,9 +463,10 @@ TEST(SampleRows, FourSampleRowsAreFourSingleSampleRows) {
         for (int j = 0; j < n; ++j)
             for (int s = 0; s < 4; ++s)
                 if (rng() % 4 == 0) {
-                    const glm::dvec3 l = mr::screen_weights(t, e[s][0] + std::int64_t{t.edge_a[0]} * mr::kSubpixelOne * j,
-                                                            e[s][1] + std::int64_t{t.edge_a[1]} * mr::kSubpixelOne * j,
-                                                            e[s][2] + std::int64_t{t.edge_a[2]} * mr::kSubpixelOne * j);
+                    const std::int64_t step = mr::kSubpixelOne * j;
+                    const glm::dvec3 l = mr::screen_weights(t, e[s][0] + std::int64_t{t.edge_a[0]} * step,
+                                                            e[s][1] + std::int64_t{t.edge_a[1]} * step,
+                                                            e[s][2] + std::int64_t{t.edge_a[2]} * step);
                     depth[static_cast<std::size_t>(j * stride + first + s)] = mr::sample_depth(t, l);
                 }
         std::vector<float> want_depth = depth;

@@ -585,16 +585,18 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 if (rows) {
                     const std::uint32_t skipped = blocks.row_pixels(cls.skipped, py, rx0, n);
                     const std::uint32_t untested = skipped | blocks.row_pixels(cls.hidden, py, rx0, n);
-                    // A multiple of four samples with AVX2: four rows at once, their depths four pixels
-                    // a vector. (No row is refused past sample 0: sample_rows_exact holds.)
+                    // A multiple of four samples with AVX2: four rows at once, their depths four
+                    // pixels a vector. (No row is refused past sample 0: sample_rows_exact holds.)
                     SampleRow four[4];
                     const bool fours = kMode == SampleMode::ssaa && vector_masks;
                     for (int s = 0; rows && s < S; ++s) {
                         SampleRow single_row;
                         if (fours && s % 4 == 0) {
                             std::int64_t e[4][3];
-                            for (int k = 0; k < 4; ++k)
-                                e[k][0] = row0 + off0[s + k], e[k][1] = row1 + off1[s + k], e[k][2] = row2 + off2[s + k];
+                            for (int k = 0; k < 4; ++k) {
+                                e[k][0] = row0 + off0[s + k], e[k][1] = row1 + off1[s + k];
+                                e[k][2] = row2 + off2[s + k];
+                            }
                             if (!test_four_sample_rows_avx2(t, e, n, ~untested, kDepth, draw.depth_write,
                                                             depth_out.at(rx0, py, s), S, four)) {
                                 rows = false;

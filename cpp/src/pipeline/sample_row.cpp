@@ -216,7 +216,7 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
             any_asked |= asked[s];
         }
         if (!any_asked) continue;
-        // stored[p]: pixel p's four samples; after the transpose, stored[s]: sample s of the pixels.
+        // stored[p]: pixel p's four samples; transposed, stored[s]: sample s of the pixels.
         float* const pixels = depth + static_cast<std::ptrdiff_t>(j) * stride;
         __m128 stored[4];
         for (int p = 0; p < 4; ++p) stored[p] = p < lanes ? _mm_loadu_ps(pixels + p * stride) : _mm_setzero_ps();
