@@ -603,11 +603,13 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                                 break;
                             }
                         }
-                        const std::int64_t e[3] = {row0 + off0[s], row1 + off1[s], row2 + off2[s]};
-                        if (!fours && !test_sample_row(t, e, n, ~untested, kDepth, draw.depth_write,
-                                                       depth_out.at(rx0, py, s), S, single_row)) {
-                            rows = false;  // (one sample, nothing done yet)
-                            break;
+                        if (!fours) {
+                            const std::int64_t e[3] = {row0 + off0[s], row1 + off1[s], row2 + off2[s]};
+                            if (!test_sample_row(t, e, n, ~untested, kDepth, draw.depth_write,
+                                                 depth_out.at(rx0, py, s), S, single_row)) {
+                                rows = false;  // (one sample, nothing done yet)
+                                break;
+                            }
                         }
                         const SampleRow& row = fours ? four[s % 4] : single_row;
                         counters.samples_covered += static_cast<std::uint64_t>(count_bits(row.covered & ~skipped));

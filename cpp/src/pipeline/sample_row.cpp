@@ -119,20 +119,63 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
     return true;
 }
 
+namespace {
+
+// test_sample_row_avx2's per-triangle terms, one value in every lane.
+struct RowTerms {
+    __m256d step[3], bias[3], inv_area2, z0, dz1, dz2;
+};
+
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline void splat_row_terms(const SetupTriangle& t, RowTerms& k) {
+    for (int i = 0; i < 3; ++i) {
+        k.step[i] = _mm256_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
+        k.bias[i] = _mm256_set1_pd(static_cast<double>(t.bias[i]));
+    }
+    k.inv_area2 = _mm256_set1_pd(t.inv_area2), k.z0 = _mm256_set1_pd(t.z0);
+    k.dz1 = _mm256_set1_pd(t.dz1), k.dz2 = _mm256_set1_pd(t.dz2);
+}
+
+// Four pixels (indices x) of a sample's row whose first pixel's edge values plus bias are `first`:
+// which are inside (bits 0 … 3), their screen weights and depths, the per-sample path's
+// arithmetic (RowEdges::at; e_i ≥ 0 ⇔ e_i + bias_i ≥ bias_i, both exact).
+struct FourPixels {
+    __m256d l0, l1, l2;
+    __m128 depths;
+    std::uint32_t inside;
+};
+
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline void four_pixels(const RowTerms& k, const __m256d (&first)[3],
+                                                                      const __m256d& x, FourPixels& p) {
+    __m256d d[3];
+    for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(first[i], _mm256_mul_pd(x, k.step[i]));
+    const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], k.bias[0], _CMP_GE_OQ),
+                                                       _mm256_cmp_pd(d[1], k.bias[1], _CMP_GE_OQ)),
+                                         _mm256_cmp_pd(d[2], k.bias[2], _CMP_GE_OQ));
+    p.l0 = _mm256_mul_pd(d[0], k.inv_area2), p.l1 = _mm256_mul_pd(d[1], k.inv_area2);
+    p.l2 = _mm256_mul_pd(d[2], k.inv_area2);
+    p.depths = _mm256_cvtpd_ps(
+        _mm256_add_pd(_mm256_add_pd(k.z0, _mm256_mul_pd(p.l1, k.dz1)), _mm256_mul_pd(p.l2, k.dz2)));
+    p.inside = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
+}
+
+// All bits of lane k where bit k of `bits` is set (k < 4).
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline __m128 lane_mask(std::uint32_t bits) {
+    return _mm_castsi128_ps(_mm_cmpgt_epi32(
+        _mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(bits)), _mm_setr_epi32(1, 2, 4, 8)), _mm_setzero_si128()));
+}
+
+}  // namespace
+
 // AVX2: the same operations on four doubles per register (one group of four pixels each), so the
 // same bits; the depth test and stores are the SSE2 path's.
 [[gnu::target("avx2")]] bool test_sample_row_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], int n,
                                                   std::uint32_t tested, DepthFunc func, bool depth_write, float* depth,
                                                   int stride, SampleRow& out) {
     if (!exact_row(t, e, n)) return false;
-    __m256d first[3], step[3], bias[3];
-    for (int i = 0; i < 3; ++i) {
-        first[i] = _mm256_set1_pd(static_cast<double>(e[i] + t.bias[i]));
-        step[i] = _mm256_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
-        bias[i] = _mm256_set1_pd(static_cast<double>(t.bias[i]));
-    }
-    const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2), z0 = _mm256_set1_pd(t.z0), dz1 = _mm256_set1_pd(t.dz1),
-                  dz2 = _mm256_set1_pd(t.dz2);
+    RowTerms k;
+    splat_row_terms(t, k);
+    __m256d first[3];
+    for (int i = 0; i < 3; ++i) first[i] = _mm256_set1_pd(static_cast<double>(e[i] + t.bias[i]));
     const bool greater = func == DepthFunc::greater;
     out.covered = out.passed = 0;
     // Pixel indices j … j + 3 (small integers: stepping them by 4 is exact; built from j each
@@ -140,37 +183,24 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
     const __m256d four = _mm256_set1_pd(4.0);
     __m256d x = _mm256_set_pd(3.0, 2.0, 1.0, 0.0);
     for (int j = 0; j < n; j += 4, x = _mm256_add_pd(x, four)) {
-        __m256d d[3];
-        for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(first[i], _mm256_mul_pd(x, step[i]));  // RowEdges::at
-        const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
-                                                           _mm256_cmp_pd(d[1], bias[1], _CMP_GE_OQ)),
-                                             _mm256_cmp_pd(d[2], bias[2], _CMP_GE_OQ));
-        const __m256d l0 = _mm256_mul_pd(d[0], inv_area2), l1 = _mm256_mul_pd(d[1], inv_area2),
-                      l2 = _mm256_mul_pd(d[2], inv_area2);
-        const __m128 depths =
-            _mm256_cvtpd_ps(_mm256_add_pd(_mm256_add_pd(z0, _mm256_mul_pd(l1, dz1)), _mm256_mul_pd(l2, dz2)));
+        FourPixels p;
+        four_pixels(k, first, x, p);
         const int lanes = n - j < 4 ? n - j : 4;
-        const std::uint32_t in_row = (1u << lanes) - 1u;
-        const std::uint32_t covered = static_cast<std::uint32_t>(_mm256_movemask_pd(inside)) & in_row;
+        const std::uint32_t covered = p.inside & ((1u << lanes) - 1u);
         out.covered |= covered << j;
         const std::uint32_t asked = covered & (tested >> j);
         if (!asked) continue;
         float* const stored = depth + j * stride;
         const __m128 s = stored_depths(stored, stride, lanes);
-        const std::uint32_t passed =
-            static_cast<std::uint32_t>(_mm_movemask_ps(greater ? _mm_cmpgt_ps(depths, s) : _mm_cmplt_ps(depths, s))) &
-            asked;
+        const std::uint32_t passed = static_cast<std::uint32_t>(_mm_movemask_ps(
+                                         greater ? _mm_cmpgt_ps(p.depths, s) : _mm_cmplt_ps(p.depths, s))) &
+                                     asked;
         if (!passed) continue;
         out.passed |= passed << j;
-        _mm256_storeu_pd(out.l0 + j, l0);
-        _mm256_storeu_pd(out.l1 + j, l1);
-        _mm256_storeu_pd(out.l2 + j, l2);
-        if (depth_write) {
-            const __m128 wins = _mm_castsi128_ps(_mm_cmpgt_epi32(
-                _mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(passed)), _mm_setr_epi32(1, 2, 4, 8)),
-                _mm_setzero_si128()));
-            store_depths(stored, stride, lanes, passed, wins, depths, s);
-        }
+        _mm256_storeu_pd(out.l0 + j, p.l0);
+        _mm256_storeu_pd(out.l1 + j, p.l1);
+        _mm256_storeu_pd(out.l2 + j, p.l2);
+        if (depth_write) store_depths(stored, stride, lanes, passed, lane_mask(passed), p.depths, s);
     }
     return true;
 }
@@ -182,35 +212,22 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
                                                         float* depth, int stride, SampleRow (&out)[4]) {
     for (int s = 0; s < 4; ++s)
         if (!exact_row(t, e[s], n)) return false;
-    __m256d first[4][3], step[3], bias[3];
-    for (int i = 0; i < 3; ++i) {
-        step[i] = _mm256_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
-        bias[i] = _mm256_set1_pd(static_cast<double>(t.bias[i]));
-        for (int s = 0; s < 4; ++s) first[s][i] = _mm256_set1_pd(static_cast<double>(e[s][i] + t.bias[i]));
-    }
-    const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2), z0 = _mm256_set1_pd(t.z0), dz1 = _mm256_set1_pd(t.dz1),
-                  dz2 = _mm256_set1_pd(t.dz2);
+    RowTerms k;
+    splat_row_terms(t, k);
+    __m256d first[4][3];
+    for (int s = 0; s < 4; ++s)
+        for (int i = 0; i < 3; ++i) first[s][i] = _mm256_set1_pd(static_cast<double>(e[s][i] + t.bias[i]));
     const bool greater = func == DepthFunc::greater;
     for (SampleRow& row : out) row.covered = row.passed = 0;
     const __m256d four = _mm256_set1_pd(4.0);
     __m256d x = _mm256_set_pd(3.0, 2.0, 1.0, 0.0);
     for (int j = 0; j < n; j += 4, x = _mm256_add_pd(x, four)) {
         const int lanes = n - j < 4 ? n - j : 4;
-        const std::uint32_t in_row = (1u << lanes) - 1u;
-        __m256d l0[4], l1[4], l2[4];
-        __m128 depths[4];
+        FourPixels p[4];
         std::uint32_t asked[4], any_asked = 0;
         for (int s = 0; s < 4; ++s) {
-            __m256d d[3];
-            for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(first[s][i], _mm256_mul_pd(x, step[i]));
-            const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
-                                                               _mm256_cmp_pd(d[1], bias[1], _CMP_GE_OQ)),
-                                                 _mm256_cmp_pd(d[2], bias[2], _CMP_GE_OQ));
-            l0[s] = _mm256_mul_pd(d[0], inv_area2), l1[s] = _mm256_mul_pd(d[1], inv_area2),
-            l2[s] = _mm256_mul_pd(d[2], inv_area2);
-            depths[s] = _mm256_cvtpd_ps(
-                _mm256_add_pd(_mm256_add_pd(z0, _mm256_mul_pd(l1[s], dz1)), _mm256_mul_pd(l2[s], dz2)));
-            const std::uint32_t covered = static_cast<std::uint32_t>(_mm256_movemask_pd(inside)) & in_row;
+            four_pixels(k, first[s], x, p[s]);
+            const std::uint32_t covered = p[s].inside & ((1u << lanes) - 1u);
             out[s].covered |= covered << j;
             asked[s] = covered & (tested >> j);
             any_asked |= asked[s];
@@ -219,27 +236,24 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         // stored[p]: pixel p's four samples; transposed, stored[s]: sample s of the pixels.
         float* const pixels = depth + static_cast<std::ptrdiff_t>(j) * stride;
         __m128 stored[4];
-        for (int p = 0; p < 4; ++p) stored[p] = p < lanes ? _mm_loadu_ps(pixels + p * stride) : _mm_setzero_ps();
+        for (int q = 0; q < 4; ++q) stored[q] = q < lanes ? _mm_loadu_ps(pixels + q * stride) : _mm_setzero_ps();
         _MM_TRANSPOSE4_PS(stored[0], stored[1], stored[2], stored[3]);
         bool wrote = false;
         for (int s = 0; s < 4; ++s) {
-            const __m128 wins = greater ? _mm_cmpgt_ps(depths[s], stored[s]) : _mm_cmplt_ps(depths[s], stored[s]);
+            const __m128 wins = greater ? _mm_cmpgt_ps(p[s].depths, stored[s]) : _mm_cmplt_ps(p[s].depths, stored[s]);
             const std::uint32_t passed = static_cast<std::uint32_t>(_mm_movemask_ps(wins)) & asked[s];
             if (!passed) continue;
             out[s].passed |= passed << j;
-            _mm256_storeu_pd(out[s].l0 + j, l0[s]);
-            _mm256_storeu_pd(out[s].l1 + j, l1[s]);
-            _mm256_storeu_pd(out[s].l2 + j, l2[s]);
+            _mm256_storeu_pd(out[s].l0 + j, p[s].l0);
+            _mm256_storeu_pd(out[s].l1 + j, p[s].l1);
+            _mm256_storeu_pd(out[s].l2 + j, p[s].l2);
             if (!depth_write) continue;
-            const __m128 passing = _mm_castsi128_ps(_mm_cmpgt_epi32(
-                _mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(passed)), _mm_setr_epi32(1, 2, 4, 8)),
-                _mm_setzero_si128()));
-            stored[s] = _mm_blendv_ps(stored[s], depths[s], passing);
+            stored[s] = _mm_blendv_ps(stored[s], p[s].depths, lane_mask(passed));
             wrote = true;
         }
         if (!wrote) continue;
         _MM_TRANSPOSE4_PS(stored[0], stored[1], stored[2], stored[3]);
-        for (int p = 0; p < lanes; ++p) _mm_storeu_ps(pixels + p * stride, stored[p]);
+        for (int q = 0; q < lanes; ++q) _mm_storeu_ps(pixels + q * stride, stored[q]);
     }
     return true;
 }
