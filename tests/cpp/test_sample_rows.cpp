@@ -88,9 +88,10 @@ TEST(SampleRows, SameBitsAndCountersAsThePerSamplePathOnOverlappingScenes) {
 }
 
 // Small triangles (a few pixels, and slivers under 8 pixels wide but up to the viewport's height)
-// at one sample a pixel take box_coverage_avx2 for their whole box and then only their covered
-// pixels: the same bits and counters as the per-sample path, textured or not, flat, blended, with
-// and without depth writes, block skipping and deferred shading.
+// at one sample a pixel take box_coverage_avx2 for their whole box, and under SSAA
+// box_sample_masks_avx2, and then only their covered pixels: the same bits and counters as the
+// per-sample path, textured or not, flat, blended, with and without depth writes, block skipping
+// and deferred shading (SSAA counts that are not a multiple of four keep the rows' path).
 TEST(SampleRows, SmallTrianglesABoxAtATimeGiveThePerSampleBits) {
     const int W = 96, H = 80;
     mr::Mesh small = random_triangles(3000, 0.12, 51, {-1.5, -1.0, -2.0}, {3.0, 2.0, 5.0}, 0.5);
@@ -118,14 +119,20 @@ TEST(SampleRows, SmallTrianglesABoxAtATimeGiveThePerSampleBits) {
                                                    make_draw(small, identity, read_only, glm::vec4(0.9f)),
                                                    make_draw(small, identity, no_depth(blend), glm::vec4(0.5f))};
                     draws[0].texture = texture;
-                    SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(blend) +
-                                 (skipping ? ", block skipping" : "") + (deferred ? ", deferred" : ""));
-                    auto s = settings(W, H, 1, mr::PatternKind::automatic);
-                    s.threads = 1;
-                    s.block_skipping = skipping;
-                    s.deferred_shading = deferred;
-                    s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
-                    expect_same_with_and_without_rows(draws, cam, s);
+                    for (const auto& [samples, pattern] :
+                         {std::pair{1, mr::PatternKind::automatic}, std::pair{4, mr::PatternKind::rotated},
+                          std::pair{6, mr::PatternKind::stratified}, std::pair{16, mr::PatternKind::grid}}) {
+                        SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(blend) +
+                                     (skipping ? ", block skipping" : "") + (deferred ? ", deferred" : "") + ", " +
+                                     std::to_string(samples) + " samples");
+                        auto s = settings(W, H, samples, pattern);
+                        s.anti_aliasing = mr::AntiAliasing::ssaa;
+                        s.threads = 1;
+                        s.block_skipping = skipping;
+                        s.deferred_shading = deferred;
+                        s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+                        expect_same_with_and_without_rows(draws, cam, s);
+                    }
                 }
     }
 }
@@ -723,6 +730,72 @@ TEST(SampleRows, BoxAndRowCoverageAreTheExactPerPixelTest) {
     EXPECT_GE(outside, 50000);
     EXPECT_GE(row_inside, 50000);
     EXPECT_GE(row_outside, 50000);
+}
+
+// box_sample_masks_avx2 (small triangles under SSAA: every sample mask of a box of up to 8 pixels by
+// up to a tile's rows at once) against the exact per-sample test: all three integer edge values
+// ≥ 0. Boxes start left of and above the triangle and run past it; sample 0 is the pixel centre,
+// through which half the triangles' edges run (edge values of exactly 0 and −1 are common).
+TEST(SampleRows, BoxSampleMasksAreTheExactPerSampleTest) {
+    if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2, which box_sample_masks_avx2 needs";
+    std::mt19937_64 rng(66);
+    long boxes = 0, on_edges = 0, inside = 0, outside = 0;
+    for (int trial = 0; trial < 10000; ++trial) {
+        mr::SetupTriangle t;
+        if (!random_row_triangle(rng, trial, t)) continue;
+        const int S = std::array<int, 4>{4, 4, 8, 16}[trial % 4];
+        std::int64_t off[3][16];
+        for (int s = 0; s < S; ++s) {
+            const std::int64_t ox = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
+            const std::int64_t oy = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
+            for (int i = 0; i < 3; ++i) off[i][s] = std::int64_t{t.edge_a[i]} * ox + std::int64_t{t.edge_b[i]} * oy;
+        }
+        const int x0 = t.min_x - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_x - t.min_x + 3));
+        const int y0 = t.min_y - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_y - t.min_y + 3));
+        const int n = 1 + static_cast<int>(rng() % mr::kernels::kBoxPixels);
+        const int rows = 1 + static_cast<int>(rng() % mr::kTileSize);
+        const std::int64_t X = std::int64_t{x0} * mr::kSubpixelOne, Y = std::int64_t{y0} * mr::kSubpixelOne;
+        std::int64_t corner[3], step_x[3], step_y[3];
+        for (int i = 0; i < 3; ++i) {
+            corner[i] = t.edge_a[i] * X + t.edge_b[i] * Y + t.edge_c[i];
+            step_x[i] = std::int64_t{t.edge_a[i]} * mr::kSubpixelOne;
+            step_y[i] = std::int64_t{t.edge_b[i]} * mr::kSubpixelOne;
+        }
+        std::uint64_t mask[mr::kTileSize][mr::kernels::kBoxPixels];
+        std::uint8_t pixels[mr::kTileSize];
+        const std::uint32_t any = mr::kernels::box_sample_masks_avx2(corner, {off[0], off[1], off[2]}, step_x, step_y,
+                                                                     n, rows, S, mask, pixels);
+        std::uint32_t want_any = 0;
+        for (int r = 0; r < rows; ++r) {
+            std::uint32_t want_pixels = 0;
+            for (int j = 0; j < n; ++j) {
+                std::uint64_t want = 0;
+                for (int s = 0; s < S; ++s) {
+                    std::int64_t E[3];
+                    for (int i = 0; i < 3; ++i)
+                        E[i] = t.edge_a[i] * (X + j * mr::kSubpixelOne) + t.edge_b[i] * (Y + r * mr::kSubpixelOne) +
+                               t.edge_c[i] + off[i][s];
+                    on_edges += E[0] == 0 || E[1] == 0 || E[2] == 0;
+                    if (E[0] >= 0 && E[1] >= 0 && E[2] >= 0) want |= std::uint64_t{1} << s;
+                }
+                ASSERT_EQ(mask[r][j], want) << "trial " << trial << " row " << r << " pixel " << j << ", " << S
+                                            << " samples";
+                if (want) want_pixels |= 1u << j;
+                inside += __builtin_popcountll(want);
+                outside += S - __builtin_popcountll(want);
+            }
+            ASSERT_EQ(pixels[r], want_pixels) << "trial " << trial << " row " << r;
+            want_any |= want_pixels;
+        }
+        ASSERT_EQ(any, want_any) << "trial " << trial;
+        ++boxes;
+    }
+    std::cout << "boxes " << boxes << ", samples on an edge " << on_edges << ", inside " << inside << ", outside "
+              << outside << "\n";
+    EXPECT_GE(boxes, 7500);
+    EXPECT_GE(on_edges, 200);
+    EXPECT_GE(inside, 50000);
+    EXPECT_GE(outside, 50000);
 }
 
 // sample_offsets_avx2 (each triangle's sample offsets under MSAA and SSAA, four per vector) against

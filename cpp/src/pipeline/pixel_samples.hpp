@@ -142,6 +142,46 @@ struct DepthPlane4 {
     }
 }
 
+/// The sample masks of a box of n ≤ kBoxPixels pixels by `rows` ≤ kTileSize rows under SSAA:
+/// bit s of mask[r][j] is set when sample s of pixel j of row r is inside, i.e. all three edge
+/// values corner[e] + off[e][s] + j·step_x[e] + r·step_y[e] are ≥ 0 (the sign bit of their OR is
+/// clear); bit j of pixels[r] when mask[r][j] has any. Four samples per int64 vector (`samples` a
+/// multiple of 4), the per-sample test's integer sums exactly. Returns the OR of pixels. Not
+/// inlined: inside the tile kernel, a small triangle's rows of masks spilled most of its values
+/// (many_small SSAA 4x: 96 instructions a row). Needs AVX2.
+inline constexpr int kBoxPixels = 8;
+[[gnu::noinline]] [[gnu::target("avx2")]] inline std::uint32_t box_sample_masks_avx2(
+    const std::int64_t (&corner)[3], const std::int64_t* const (&off)[3], const std::int64_t (&step_x)[3],
+    const std::int64_t (&step_y)[3], int n, int rows, int samples, std::uint64_t (*mask)[kBoxPixels],
+    std::uint8_t* pixels) {
+    __m256i across[3], down[3];
+    for (int e = 0; e < 3; ++e) across[e] = _mm256_set1_epi64x(step_x[e]), down[e] = _mm256_set1_epi64x(step_y[e]);
+    for (int g = 0; g < samples; g += 4) {
+        __m256i row[3];  // samples g … g + 3 of the row's first pixel
+        for (int e = 0; e < 3; ++e)
+            row[e] = _mm256_add_epi64(_mm256_set1_epi64x(corner[e]),
+                                      _mm256_loadu_si256(reinterpret_cast<const __m256i*>(off[e] + g)));
+        for (int r = 0; r < rows; ++r) {
+            __m256i at[3] = {row[0], row[1], row[2]};
+            for (int j = 0; j < n; ++j) {
+                const __m256i any = _mm256_or_si256(_mm256_or_si256(at[0], at[1]), at[2]);
+                const auto inside = static_cast<std::uint64_t>(~_mm256_movemask_pd(_mm256_castsi256_pd(any)) & 15);
+                mask[r][j] = g == 0 ? inside : mask[r][j] | inside << g;
+                for (int e = 0; e < 3; ++e) at[e] = _mm256_add_epi64(at[e], across[e]);
+            }
+            for (int e = 0; e < 3; ++e) row[e] = _mm256_add_epi64(row[e], down[e]);
+        }
+    }
+    std::uint32_t any = 0;
+    for (int r = 0; r < rows; ++r) {
+        std::uint32_t bits = 0;
+        for (int j = 0; j < n; ++j) bits |= static_cast<std::uint32_t>(mask[r][j] != 0) << j;
+        pixels[r] = static_cast<std::uint8_t>(bits);
+        any |= bits;
+    }
+    return any;
+}
+
 // Edge values first + k·step in lanes k = 0 … 3: step in the odd lanes plus 2·step in the upper
 // two (AVX2 has no 64-bit multiply).
 [[gnu::always_inline]] [[gnu::target("avx2")]] inline __m256i four_steps(std::int64_t first, std::int64_t step) {

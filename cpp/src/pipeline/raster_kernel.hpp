@@ -316,8 +316,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     // Coverage masks four samples per vector (pixel_coverage_avx2; also MSAA's depth tests,
     // pixel_vectors below).
     const bool vector_masks = target.sample_rows && S % 4 == 0 && BatchSampler::widest_vector() == 8;
-    // Small triangles' pixels at one sample a pixel found a box at a time (box_coverage_avx2).
-    const bool box_rows = kMode == SampleMode::single && target.sample_rows && BatchSampler::widest_vector() == 8;
+    // Small triangles' pixels at one sample a pixel, and under SSAA with the vector masks, found a
+    // box at a time (box_coverage_avx2, box_sample_masks_avx2).
+    const bool box_rows = target.sample_rows && BatchSampler::widest_vector() == 8 &&
+                          (kMode == SampleMode::single || (kMode == SampleMode::ssaa && vector_masks));
     std::optional<LookupQueue<kBlend, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
     // An alpha-tested draw's batched lookups (alpha_tested_triangle), where a draw without a cutoff
@@ -439,6 +441,31 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
         };
 
+        // The samples `covered` of pixel (px, py), whose corner has edge values p0, p1, p2, one by one:
+        // each that passes the depth test is shaded. depth_px, color_px: the pixel's slots.
+        const auto shade_samples = [&](int px, int py, std::int64_t p0, std::int64_t p1, std::int64_t p2,
+                                       std::uint64_t covered, float* depth_px, float* color_px) {
+            bool written = false;
+            for (; covered; covered &= covered - 1) {
+                const int s = __builtin_ctzll(covered);
+                ++counters.samples_covered;
+                const std::int64_t e0 = p0 + off0[s], e1 = p1 + off1[s], e2 = p2 + off2[s];
+                glm::dvec3 l(0.0);
+                if constexpr (kDepth != DepthFunc::none || kShading == Shading::screen ||
+                              kShading == Shading::perspective || kShading == Shading::visibility ||
+                              kTexturing != Texturing::none)
+                    l = screen_weights(t, e0, e1, e2);
+                if constexpr (kDepth != DepthFunc::none) {
+                    const float z = sample_depth(t, l);
+                    if (!depth_passes<kDepth>(z, depth_px[s])) continue;
+                    if (draw.depth_write) depth_px[s] = z;
+                    written = true;
+                }
+                passed_sample(color_px, px, py, s, l);
+            }
+            if (written) blocks.written(px, py);
+        };
+
         // The passed pixels of a row's sample s (bit j: pixel rx0 + j) at once, as passed_sample takes
         // them one by one: for queued lookups, untextured colours by row and the deferred pre-pass's
         // owners (false: none of them).
@@ -518,26 +545,48 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             queue->push_row(color_out.at(rx0, py, 0), 4 * S, pixels, l0, l1, l2, rx0, py, samples);
         };
 
-        // At one sample a pixel, a triangle narrower than a sample row with no block classified
-        // (most of many_small's): the coverage of its whole box at once (box_coverage_avx2), then
-        // its covered pixels in the order of the rows below, without their rows' set-up or the
-        // tests of the pixels it misses (many_small 1x: a third of the kernel's instructions).
+        // At one sample a pixel or SSAA, a triangle narrower than a sample row with no block
+        // classified (most of many_small's): the coverage of its whole box at once, then its covered
+        // pixels in the order of the rows below, without their rows' set-up or the tests of the
+        // pixels it misses (box_coverage_avx2 at one sample: many_small 1x, a third of the kernel's
+        // instructions; box_sample_masks_avx2 under SSAA: many_small SSAA 4x −8 %).
         if (box_rows && !classified && x1 - x0 < kSampleRowMinPixels) {
-            // Edge values at the sample of pixel (x0, y0), and the pixel's slots: the per-sample
+            // Edge values at the corner of pixel (x0, y0), and the pixel's slots: the per-sample
             // path's integers, and addresses from the windows' fields read once.
             const std::int64_t X = std::int64_t{x0} * kStep, Y = std::int64_t{y0} * kStep;
-            std::int64_t e[3] = {t.edge_a[0] * X + t.edge_b[0] * Y + t.edge_c[0] + off0[0],
-                                 t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1] + off1[0],
-                                 t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2] + off2[0]};
+            std::int64_t e[3] = {t.edge_a[0] * X + t.edge_b[0] * Y + t.edge_c[0],
+                                 t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1],
+                                 t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2]};
             const std::int64_t down[3] = {t.edge_b[0] * kStep, t.edge_b[1] * kStep, t.edge_b[2] * kStep};
-            std::uint8_t cover[kTileSize];
-            if (!box_coverage_avx2(e, {step0, step1, step2}, down, x1 - x0, y1 - y0, cover)) continue;
             float* depth_row = kDepth != DepthFunc::none ? depth_out.at(x0, y0, 0) : nullptr;
             float* color_row = colour_slots(x0, y0);
             const std::ptrdiff_t depth_pixel = kDepth != DepthFunc::none ? depth_out.samples * depth_out.channels : 0;
             const std::ptrdiff_t depth_line = depth_pixel * depth_out.pitch;
             const std::ptrdiff_t color_pixel = color_out.samples * color_out.channels;
             const std::ptrdiff_t color_line = color_pixel * color_out.pitch;
+            if constexpr (kMode == SampleMode::ssaa) {
+                static_assert(kSampleRowMinPixels <= kBoxPixels, "a box's row of masks");
+                std::uint64_t masks[kTileSize][kBoxPixels];
+                std::uint8_t pixels[kTileSize];
+                if (!box_sample_masks_avx2(e, {off0, off1, off2}, {step0, step1, step2}, down, x1 - x0, y1 - y0, S,
+                                           masks, pixels))
+                    continue;
+                for (int py = y0; py < y1; ++py) {
+                    for (std::uint32_t m = pixels[py - y0]; m; m &= m - 1) {
+                        const int j = __builtin_ctz(m);
+                        shade_samples(x0 + j, py, e[0] + j * step0, e[1] + j * step1, e[2] + j * step2,
+                                      masks[py - y0][j], depth_row + j * depth_pixel,
+                                      kShading == Shading::visibility ? nullptr : color_row + j * color_pixel);
+                    }
+                    for (int k = 0; k < 3; ++k) e[k] += down[k];
+                    depth_row += depth_line;
+                    if constexpr (kShading != Shading::visibility) color_row += color_line;
+                }
+                continue;
+            }
+            e[0] += off0[0], e[1] += off1[0], e[2] += off2[0];  // (at its one sample)
+            std::uint8_t cover[kTileSize];
+            if (!box_coverage_avx2(e, {step0, step1, step2}, down, x1 - x0, y1 - y0, cover)) continue;
             for (int py = y0; py < y1; ++py) {
                 // The per-sample path's steps for sample 0 of each covered pixel.
                 for (std::uint32_t m = cover[py - y0]; m; m &= m - 1) {
@@ -734,27 +783,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                                                                  colors, uvs, t, l, batch.clip_weights, px, py);
                     }
                 } else {
-                    // Shade every covered sample that passes the depth test.
-                    float* const color_px = colour_slots(px, py);
-                    bool written = false;
-                    for (; covered; covered &= covered - 1) {
-                        const int s = __builtin_ctzll(covered);
-                        ++counters.samples_covered;
-                        const std::int64_t e0 = p0 + off0[s], e1 = p1 + off1[s], e2 = p2 + off2[s];
-                        glm::dvec3 l(0.0);
-                        if constexpr (kDepth != DepthFunc::none || kShading == Shading::screen ||
-                                      kShading == Shading::perspective || kShading == Shading::visibility ||
-                                      kTexturing != Texturing::none)
-                            l = screen_weights(t, e0, e1, e2);
-                        if constexpr (kDepth != DepthFunc::none) {
-                            const float z = sample_depth(t, l);
-                            if (!depth_passes<kDepth>(z, depth_px[s])) continue;
-                            if (draw.depth_write) depth_px[s] = z;
-                            written = true;
-                        }
-                        passed_sample(color_px, px, py, s, l);
-                    }
-                    if (written) blocks.written(px, py);
+                    shade_samples(px, py, p0, p1, p2, covered, depth_px, colour_slots(px, py));
                 }
             }
         }
