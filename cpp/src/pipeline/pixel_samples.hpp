@@ -156,6 +156,7 @@ inline constexpr int kBoxPixels = 8;
     std::uint8_t* pixels) {
     __m256i across[3], down[3];
     for (int e = 0; e < 3; ++e) across[e] = _mm256_set1_epi64x(step_x[e]), down[e] = _mm256_set1_epi64x(step_y[e]);
+    std::uint32_t any_pixel = 0;
     for (int g = 0; g < samples; g += 4) {
         __m256i row[3];  // samples g … g + 3 of the row's first pixel
         for (int e = 0; e < 3; ++e)
@@ -163,23 +164,20 @@ inline constexpr int kBoxPixels = 8;
                                       _mm256_loadu_si256(reinterpret_cast<const __m256i*>(off[e] + g)));
         for (int r = 0; r < rows; ++r) {
             __m256i at[3] = {row[0], row[1], row[2]};
+            std::uint32_t bits = 0;  // the row's pixels with one of these samples inside
             for (int j = 0; j < n; ++j) {
                 const __m256i any = _mm256_or_si256(_mm256_or_si256(at[0], at[1]), at[2]);
                 const auto inside = static_cast<std::uint64_t>(~_mm256_movemask_pd(_mm256_castsi256_pd(any)) & 15);
                 mask[r][j] = g == 0 ? inside : mask[r][j] | inside << g;
+                bits |= static_cast<std::uint32_t>(inside != 0) << j;
                 for (int e = 0; e < 3; ++e) at[e] = _mm256_add_epi64(at[e], across[e]);
             }
+            pixels[r] = static_cast<std::uint8_t>(g == 0 ? bits : pixels[r] | bits);
+            any_pixel |= bits;
             for (int e = 0; e < 3; ++e) row[e] = _mm256_add_epi64(row[e], down[e]);
         }
     }
-    std::uint32_t any = 0;
-    for (int r = 0; r < rows; ++r) {
-        std::uint32_t bits = 0;
-        for (int j = 0; j < n; ++j) bits |= static_cast<std::uint32_t>(mask[r][j] != 0) << j;
-        pixels[r] = static_cast<std::uint8_t>(bits);
-        any |= bits;
-    }
-    return any;
+    return any_pixel;
 }
 
 // Edge values first + k·step in lanes k = 0 … 3: step in the odd lanes plus 2·step in the upper
