@@ -88,10 +88,10 @@ TEST(SampleRows, SameBitsAndCountersAsThePerSamplePathOnOverlappingScenes) {
 }
 
 // Small triangles (a few pixels, and slivers under 8 pixels wide but up to the viewport's height)
-// at one sample a pixel take box_coverage_avx2 for their whole box, and under SSAA
+// at one sample a pixel take box_coverage_avx2 for their whole box, and under SSAA and MSAA
 // box_sample_masks_avx2, and then only their covered pixels: the same bits and counters as the
 // per-sample path, textured or not, flat, blended, with and without depth writes, block skipping
-// and deferred shading (SSAA counts that are not a multiple of four keep the rows' path).
+// and deferred shading (sample counts that are not a multiple of four keep the rows' path).
 TEST(SampleRows, SmallTrianglesABoxAtATimeGiveThePerSampleBits) {
     const int W = 96, H = 80;
     mr::Mesh small = random_triangles(3000, 0.12, 51, {-1.5, -1.0, -2.0}, {3.0, 2.0, 5.0}, 0.5);
@@ -119,14 +119,18 @@ TEST(SampleRows, SmallTrianglesABoxAtATimeGiveThePerSampleBits) {
                                                    make_draw(small, identity, read_only, glm::vec4(0.9f)),
                                                    make_draw(small, identity, no_depth(blend), glm::vec4(0.5f))};
                     draws[0].texture = texture;
-                    for (const auto& [samples, pattern] :
-                         {std::pair{1, mr::PatternKind::automatic}, std::pair{4, mr::PatternKind::rotated},
-                          std::pair{6, mr::PatternKind::stratified}, std::pair{16, mr::PatternKind::grid}}) {
+                    for (const auto& [samples, pattern, aa] :
+                         {std::tuple{1, mr::PatternKind::automatic, mr::AntiAliasing::ssaa},
+                          std::tuple{4, mr::PatternKind::rotated, mr::AntiAliasing::ssaa},
+                          std::tuple{6, mr::PatternKind::stratified, mr::AntiAliasing::ssaa},
+                          std::tuple{16, mr::PatternKind::grid, mr::AntiAliasing::ssaa},
+                          std::tuple{4, mr::PatternKind::rotated, mr::AntiAliasing::msaa},
+                          std::tuple{8, mr::PatternKind::stratified, mr::AntiAliasing::msaa}}) {
                         SCOPED_TRACE(mr::to_string(convention) + ", " + mr::to_string(blend) +
                                      (skipping ? ", block skipping" : "") + (deferred ? ", deferred" : "") + ", " +
-                                     std::to_string(samples) + " samples");
+                                     std::to_string(samples) + " samples " + mr::to_string(aa));
                         auto s = settings(W, H, samples, pattern);
-                        s.anti_aliasing = mr::AntiAliasing::ssaa;
+                        s.anti_aliasing = aa;
                         s.threads = 1;
                         s.block_skipping = skipping;
                         s.deferred_shading = deferred;

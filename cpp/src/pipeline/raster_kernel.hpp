@@ -316,10 +316,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     // Coverage masks four samples per vector (pixel_coverage_avx2; also MSAA's depth tests,
     // pixel_vectors below).
     const bool vector_masks = target.sample_rows && S % 4 == 0 && BatchSampler::widest_vector() == 8;
-    // Small triangles' pixels at one sample a pixel, and under SSAA with the vector masks, found a
-    // box at a time (box_coverage_avx2, box_sample_masks_avx2).
+    // Small triangles' pixels at one sample a pixel, and with several samples where the vector masks
+    // are, found a box at a time (box_coverage_avx2, box_sample_masks_avx2).
     const bool box_rows = target.sample_rows && BatchSampler::widest_vector() == 8 &&
-                          (kMode == SampleMode::single || (kMode == SampleMode::ssaa && vector_masks));
+                          (kMode == SampleMode::single || vector_masks);
     std::optional<LookupQueue<kBlend, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
     // An alpha-tested draw's batched lookups (alpha_tested_triangle), where a draw without a cutoff
@@ -442,9 +442,12 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         };
 
         // The samples `covered` of pixel (px, py), whose corner has edge values p0, p1, p2, one by one:
-        // each that passes the depth test is shaded. depth_px, color_px: the pixel's slots.
+        // each that passes the depth test is shaded. depth_px, color_px: the pixel's slots. (This and
+        // msaa_pixel are always inlined: called from two places, GCC made them functions reading
+        // their captures through memory, +11 % instructions in many_small MSAA 4x.)
         const auto shade_samples = [&](int px, int py, std::int64_t p0, std::int64_t p1, std::int64_t p2,
-                                       std::uint64_t covered, float* depth_px, float* color_px) {
+                                       std::uint64_t covered, float* depth_px,
+                                       float* color_px) __attribute__((always_inline)) {
             bool written = false;
             for (; covered; covered &= covered - 1) {
                 const int s = __builtin_ctzll(covered);
@@ -509,6 +512,54 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
         };
 
+        // Under MSAA, the samples `covered` of pixel (px, py), whose corner has edge values p0, p1, p2:
+        // depth per sample, colour once per pixel, at the pixel centre when it is inside the
+        // triangle, else at the first covered sample that passed (never extrapolated).
+        const auto msaa_pixel = [&](int px, int py, std::int64_t p0, std::int64_t p1, std::int64_t p2,
+                                    std::uint64_t covered, float* depth_px) __attribute__((always_inline)) {
+            float* const color_px = kShading == Shading::visibility ? nullptr : color_out.at(px, py, 0);
+            std::uint64_t passed = 0;
+            if (pixel_vectors && covered == all_samples &&
+                test_pixel_samples_avx2(t, {p1, p2, offset1, offset2, S}, covered, kDepth, draw.depth_write,
+                                        depth_px, passed)) {
+                counters.samples_covered += static_cast<std::uint64_t>(count_bits(covered));
+                covered = 0;  // (all tested)
+            }
+            for (std::uint64_t m = covered; m; m &= m - 1) {
+                const int s = __builtin_ctzll(m);
+                ++counters.samples_covered;
+                if constexpr (kDepth != DepthFunc::none) {
+                    const float z = sample_depth(t, screen_weights(t, p0 + off0[s], p1 + off1[s], p2 + off2[s]));
+                    if (!depth_passes<kDepth>(z, depth_px[s])) continue;
+                    if (draw.depth_write) depth_px[s] = z;
+                }
+                passed |= std::uint64_t{1} << s;
+            }
+            if (!passed) return;
+            if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
+            counters.samples_passed += static_cast<std::uint64_t>(count_bits(passed));
+            const bool at_centre = ((p0 + to_centre0) | (p1 + to_centre1) | (p2 + to_centre2)) >= 0;
+            if constexpr (kShading == Shading::visibility) {
+                record_owner(px, py, passed, at_centre);  // (the shade below, deferred)
+            } else {
+                ++counters.shader_invocations;
+                glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
+                if constexpr (!((kShading == Shading::constant || kShading == Shading::flat) &&
+                                kTexturing == Texturing::none)) {
+                    std::int64_t c0 = p0 + to_centre0, c1 = p1 + to_centre1, c2 = p2 + to_centre2;
+                    if (!at_centre) {
+                        const int s = __builtin_ctzll(passed);
+                        c0 = p0 + off0[s];
+                        c1 = p1 + off1[s];
+                        c2 = p2 + off2[s];
+                    }
+                    l = screen_weights(t, c0, c1, c2);
+                }
+                shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px, passed, draw,
+                                                         colors, uvs, t, l, batch.clip_weights, px, py);
+            }
+        };
+
         // A long MSAA row of pixels rx0 … rx0 + n − 1 whose first pixel's corner has edge values
         // `corner`, where sample_rows_exact holds and no block is skipped or hidden. Each pixel is
         // shaded once (or, in the pre-pass, its owner recorded), at its centre when that is inside
@@ -545,11 +596,11 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             queue->push_row(color_out.at(rx0, py, 0), 4 * S, pixels, l0, l1, l2, rx0, py, samples);
         };
 
-        // At one sample a pixel or SSAA, a triangle narrower than a sample row with no block
-        // classified (most of many_small's): the coverage of its whole box at once, then its covered
-        // pixels in the order of the rows below, without their rows' set-up or the tests of the
-        // pixels it misses (box_coverage_avx2 at one sample: many_small 1x, a third of the kernel's
-        // instructions; box_sample_masks_avx2 under SSAA: many_small SSAA 4x −8 %).
+        // A triangle narrower than a sample row with no block classified (most of many_small's): the
+        // coverage of its whole box at once, then its covered pixels in the order of the rows below,
+        // without their rows' set-up or the tests of the pixels it misses (box_coverage_avx2 at one
+        // sample: many_small 1x, a third of the kernel's instructions; box_sample_masks_avx2 with
+        // four samples a vector: many_small SSAA 4x −8 %, MSAA 4x −9 %).
         if (box_rows && !classified && x1 - x0 < kSampleRowMinPixels) {
             // Edge values at the corner of pixel (x0, y0), and the pixel's slots: the per-sample
             // path's integers, and addresses from the windows' fields read once.
@@ -564,7 +615,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             const std::ptrdiff_t depth_line = depth_pixel * depth_out.pitch;
             const std::ptrdiff_t color_pixel = color_out.samples * color_out.channels;
             const std::ptrdiff_t color_line = color_pixel * color_out.pitch;
-            if constexpr (kMode == SampleMode::ssaa) {
+            if constexpr (kMode != SampleMode::single) {
                 static_assert(kSampleRowMinPixels <= kBoxPixels, "a box's row of masks");
                 std::uint64_t masks[kTileSize][kBoxPixels];
                 std::uint8_t pixels[kTileSize];
@@ -574,9 +625,12 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 for (int py = y0; py < y1; ++py) {
                     for (std::uint32_t m = pixels[py - y0]; m; m &= m - 1) {
                         const int j = __builtin_ctz(m);
-                        shade_samples(x0 + j, py, e[0] + j * step0, e[1] + j * step1, e[2] + j * step2,
-                                      masks[py - y0][j], depth_row + j * depth_pixel,
-                                      kShading == Shading::visibility ? nullptr : color_row + j * color_pixel);
+                        const std::int64_t p0 = e[0] + j * step0, p1 = e[1] + j * step1, p2 = e[2] + j * step2;
+                        if constexpr (kMode == SampleMode::msaa)
+                            msaa_pixel(x0 + j, py, p0, p1, p2, masks[py - y0][j], depth_row + j * depth_pixel);
+                        else
+                            shade_samples(x0 + j, py, p0, p1, p2, masks[py - y0][j], depth_row + j * depth_pixel,
+                                          kShading == Shading::visibility ? nullptr : color_row + j * color_pixel);
                     }
                     for (int k = 0; k < 3; ++k) e[k] += down[k];
                     depth_row += depth_line;
@@ -739,49 +793,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 float* const depth_px = kDepth != DepthFunc::none ? depth_out.at(px, py, 0) : nullptr;
 
                 if constexpr (kMode == SampleMode::msaa) {
-                    float* const color_px = kShading == Shading::visibility ? nullptr : color_out.at(px, py, 0);
-                    // Depth per sample, colour once per pixel: at the pixel centre when it is inside the
-                    // triangle, else at the first covered sample that passed (never extrapolated).
-                    std::uint64_t passed = 0;
-                    if (pixel_vectors && covered == all_samples &&
-                        test_pixel_samples_avx2(t, {p1, p2, offset1, offset2, S}, covered, kDepth, draw.depth_write,
-                                                depth_px, passed)) {
-                        counters.samples_covered += static_cast<std::uint64_t>(count_bits(covered));
-                        covered = 0;  // (all tested)
-                    }
-                    for (std::uint64_t m = covered; m; m &= m - 1) {
-                        const int s = __builtin_ctzll(m);
-                        ++counters.samples_covered;
-                        if constexpr (kDepth != DepthFunc::none) {
-                            const float z = sample_depth(t, screen_weights(t, p0 + off0[s], p1 + off1[s], p2 + off2[s]));
-                            if (!depth_passes<kDepth>(z, depth_px[s])) continue;
-                            if (draw.depth_write) depth_px[s] = z;
-                        }
-                        passed |= std::uint64_t{1} << s;
-                    }
-                    if (!passed) continue;
-                    if constexpr (kDepth != DepthFunc::none) blocks.written(px, py);
-                    counters.samples_passed += static_cast<std::uint64_t>(count_bits(passed));
-                    const bool at_centre = ((p0 + to_centre0) | (p1 + to_centre1) | (p2 + to_centre2)) >= 0;
-                    if constexpr (kShading == Shading::visibility) {
-                        record_owner(px, py, passed, at_centre);  // (the shade below, deferred)
-                    } else {
-                        ++counters.shader_invocations;
-                        glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
-                        if constexpr (!((kShading == Shading::constant || kShading == Shading::flat) &&
-                                        kTexturing == Texturing::none)) {
-                            std::int64_t c0 = p0 + to_centre0, c1 = p1 + to_centre1, c2 = p2 + to_centre2;
-                            if (!at_centre) {
-                                const int s = __builtin_ctzll(passed);
-                                c0 = p0 + off0[s];
-                                c1 = p1 + off1[s];
-                                c2 = p2 + off2[s];
-                            }
-                            l = screen_weights(t, c0, c1, c2);
-                        }
-                        shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px, passed, draw,
-                                                                 colors, uvs, t, l, batch.clip_weights, px, py);
-                    }
+                    msaa_pixel(px, py, p0, p1, p2, covered, depth_px);
                 } else {
                     shade_samples(px, py, p0, p1, p2, covered, depth_px, colour_slots(px, py));
                 }
