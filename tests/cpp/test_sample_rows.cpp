@@ -619,6 +619,16 @@ TEST(SampleRows, PixelRowsGiveThePerSampleArithmeticOnRandomRows) {
     EXPECT_GE(passed_samples, 50000);
 }
 
+// Edge offsets off[e][s] = a_e·x + b_e·y of S random sample positions in a pixel's 256 subpixel
+// steps, sample 0 at the pixel centre (through which half of random_row_triangle's edges run).
+void random_sample_offsets(std::mt19937_64& rng, const mr::SetupTriangle& t, int S, std::int64_t (&off)[3][16]) {
+    for (int s = 0; s < S; ++s) {
+        const std::int64_t ox = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
+        const std::int64_t oy = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
+        for (int i = 0; i < 3; ++i) off[i][s] = std::int64_t{t.edge_a[i]} * ox + std::int64_t{t.edge_b[i]} * oy;
+    }
+}
+
 // pixel_coverage_avx2 (MSAA and SSAA rows' coverage masks, four samples per vector) against the
 // exact per-sample test: all three integer edge values ≥ 0. Rows start left of the triangle and
 // run past it; sample 0 is the pixel centre, through which half the triangles' edges run, so
@@ -632,11 +642,7 @@ TEST(SampleRows, CoverageMasksFourSamplesPerVectorAreTheExactPerSampleTest) {
         if (!random_row_triangle(rng, trial, t)) continue;
         const int S = std::array<int, 4>{4, 4, 8, 16}[trial % 4];
         std::int64_t off[3][16];
-        for (int s = 0; s < S; ++s) {
-            const std::int64_t ox = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
-            const std::int64_t oy = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
-            for (int i = 0; i < 3; ++i) off[i][s] = std::int64_t{t.edge_a[i]} * ox + std::int64_t{t.edge_b[i]} * oy;
-        }
+        random_sample_offsets(rng, t, S, off);
         const int y = t.min_y + static_cast<int>(rng() % static_cast<unsigned>(t.max_y - t.min_y + 1));
         const int x0 = t.min_x - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_x - t.min_x + 3));
         const int n = 1 + static_cast<int>(rng() % mr::kTileSize);
@@ -736,10 +742,11 @@ TEST(SampleRows, BoxAndRowCoverageAreTheExactPerPixelTest) {
     EXPECT_GE(row_outside, 50000);
 }
 
-// box_sample_masks_avx2 (small triangles under SSAA: every sample mask of a box of up to 8 pixels by
-// up to a tile's rows at once) against the exact per-sample test: all three integer edge values
-// ≥ 0. Boxes start left of and above the triangle and run past it; sample 0 is the pixel centre,
-// through which half the triangles' edges run (edge values of exactly 0 and −1 are common).
+// box_sample_masks_avx2 (small triangles under SSAA and MSAA: every sample mask of a box of up to
+// 8 pixels by up to a tile's rows at once) against the exact per-sample test: all three integer
+// edge values ≥ 0. Boxes start left of and above the triangle and run past it; sample 0 is the
+// pixel centre, through which half the triangles' edges run (edge values of exactly 0 and −1 are
+// common).
 TEST(SampleRows, BoxSampleMasksAreTheExactPerSampleTest) {
     if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "this CPU has no AVX2, which box_sample_masks_avx2 needs";
     std::mt19937_64 rng(66);
@@ -749,11 +756,7 @@ TEST(SampleRows, BoxSampleMasksAreTheExactPerSampleTest) {
         if (!random_row_triangle(rng, trial, t)) continue;
         const int S = std::array<int, 4>{4, 4, 8, 16}[trial % 4];
         std::int64_t off[3][16];
-        for (int s = 0; s < S; ++s) {
-            const std::int64_t ox = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
-            const std::int64_t oy = s == 0 ? 128 : static_cast<std::int64_t>(rng() % 256);
-            for (int i = 0; i < 3; ++i) off[i][s] = std::int64_t{t.edge_a[i]} * ox + std::int64_t{t.edge_b[i]} * oy;
-        }
+        random_sample_offsets(rng, t, S, off);
         const int x0 = t.min_x - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_x - t.min_x + 3));
         const int y0 = t.min_y - 2 + static_cast<int>(rng() % static_cast<unsigned>(t.max_y - t.min_y + 3));
         const int n = 1 + static_cast<int>(rng() % mr::kernels::kBoxPixels);

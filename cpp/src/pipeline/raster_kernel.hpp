@@ -316,8 +316,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     // Coverage masks four samples per vector (pixel_coverage_avx2; also MSAA's depth tests,
     // pixel_vectors below).
     const bool vector_masks = target.sample_rows && S % 4 == 0 && BatchSampler::widest_vector() == 8;
-    // Small triangles' pixels at one sample a pixel, and with several samples where the vector masks
-    // are, found a box at a time (box_coverage_avx2, box_sample_masks_avx2).
+    // Small triangles' pixels at one sample a pixel, and with several samples where the vector
+    // masks are, found a box at a time (box_coverage_avx2, box_sample_masks_avx2).
     const bool box_rows = target.sample_rows && BatchSampler::widest_vector() == 8 &&
                           (kMode == SampleMode::single || vector_masks);
     std::optional<LookupQueue<kBlend, kShading, kTexturing>> queue;
@@ -441,10 +441,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
         };
 
-        // The samples `covered` of pixel (px, py), whose corner has edge values p0, p1, p2, one by one:
-        // each that passes the depth test is shaded. depth_px, color_px: the pixel's slots. (This and
-        // msaa_pixel are always inlined: called from two places, GCC made them functions reading
-        // their captures through memory, +11 % instructions in many_small MSAA 4x.)
+        // The samples `covered` of pixel (px, py), whose corner has edge values p0, p1, p2, one by
+        // one: each that passes the depth test is shaded. depth_px, color_px: the pixel's slots.
+        // (This and msaa_pixel are always inlined: called from two places, GCC made them functions
+        // reading their captures through memory, +11 % instructions in many_small MSAA 4x.)
         const auto shade_samples = [&](int px, int py, std::int64_t p0, std::int64_t p1, std::int64_t p2,
                                        std::uint64_t covered, float* depth_px,
                                        float* color_px) __attribute__((always_inline)) {
@@ -512,8 +512,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
         };
 
-        // Under MSAA, the samples `covered` of pixel (px, py), whose corner has edge values p0, p1, p2:
-        // depth per sample, colour once per pixel, at the pixel centre when it is inside the
+        // Under MSAA, the samples `covered` of pixel (px, py), whose corner has edge values p0, p1,
+        // p2: depth per sample, colour once per pixel, at the pixel centre when it is inside the
         // triangle, else at the first covered sample that passed (never extrapolated).
         const auto msaa_pixel = [&](int px, int py, std::int64_t p0, std::int64_t p1, std::int64_t p2,
                                     std::uint64_t covered, float* depth_px) __attribute__((always_inline)) {
@@ -596,11 +596,11 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             queue->push_row(color_out.at(rx0, py, 0), 4 * S, pixels, l0, l1, l2, rx0, py, samples);
         };
 
-        // A triangle narrower than a sample row with no block classified (most of many_small's): the
-        // coverage of its whole box at once, then its covered pixels in the order of the rows below,
-        // without their rows' set-up or the tests of the pixels it misses (box_coverage_avx2 at one
-        // sample: many_small 1x, a third of the kernel's instructions; box_sample_masks_avx2 with
-        // four samples a vector: many_small SSAA 4x −8 %, MSAA 4x −9 %).
+        // A triangle narrower than a sample row with no block classified (most of many_small's):
+        // the coverage of its whole box at once, then its covered pixels in the order of the rows
+        // below, without their rows' set-up or the tests of the pixels it misses (box_coverage_avx2
+        // at one sample: many_small 1x, a third of the kernel's instructions; box_sample_masks_avx2
+        // with four samples a vector: many_small SSAA 4x −8 %, MSAA 4x −9 %).
         if (box_rows && !classified && x1 - x0 < kSampleRowMinPixels) {
             // Edge values at the corner of pixel (x0, y0), and the pixel's slots: the per-sample
             // path's integers, and addresses from the windows' fields read once.
