@@ -142,7 +142,7 @@ struct DepthPlane4 {
     }
 }
 
-/// The sample masks of a box of n ≤ kBoxPixels pixels by `rows` ≤ kTileSize rows under SSAA:
+/// The sample masks of a box of n ≤ kBoxPixels pixels by `rows` ≤ kTileSize rows (SSAA or MSAA):
 /// bit s of mask[r][j] is set when sample s of pixel j of row r is inside, i.e. all three edge
 /// values corner[e] + off[e][s] + j·step_x[e] + r·step_y[e] are ≥ 0 (the sign bit of their OR is
 /// clear); bit j of pixels[r] when mask[r][j] has any. Four samples per int64 vector (`samples` a
