@@ -336,6 +336,16 @@ bool set_up(const std::array<glm::dvec2, 3>& v, int N, mr::SetupTriangle& t) {
     return mr::setup_triangle(p, vp, mr::CullMode::none, t, counters);
 }
 
+// The area (shoelace formula) and perimeter of the screen triangle v, in pixels.
+double triangle_area(const std::array<glm::dvec2, 3>& v) {
+    return 0.5 * std::abs((v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[2].x - v[0].x) * (v[1].y - v[0].y));
+}
+double triangle_perimeter(const std::array<glm::dvec2, 3>& v) {
+    double perimeter = 0.0;
+    for (int i = 0; i < 3; ++i) perimeter += glm::length(v[(i + 1) % 3] - v[i]);
+    return perimeter;
+}
+
 // The overlap estimate that decides deferring (tile_overlap_area, added up while binning) against
 // independent values: a triangle inside the rectangle counts its own area (the shoelace formula on
 // its screen vertices, within their snapping to 1/256 px), a rectangle inside the triangle counts
@@ -362,10 +372,7 @@ TEST(DeferredShading, OverlapAreaIsTheTriangleOrTheRectangleWhereOneHoldsTheOthe
             EXPECT_EQ(got, 0.0);
         } else if (t.min_x > x0 && t.max_x + 1 < x1 && t.min_y > y0 && t.max_y + 1 < y1) {
             ++inside;
-            const double area = 0.5 * std::abs((v[1].x - v[0].x) * (v[2].y - v[0].y) - (v[2].x - v[0].x) * (v[1].y - v[0].y));
-            double perimeter = 0.0;
-            for (int i = 0; i < 3; ++i) perimeter += glm::length(v[(i + 1) % 3] - v[i]);
-            EXPECT_NEAR(got, area, perimeter / 256.0 + 1e-9) << "triangle of size " << size;
+            EXPECT_NEAR(got, triangle_area(v), triangle_perimeter(v) / 256.0 + 1e-9) << "triangle of size " << size;
         } else {
             // The rectangle inside the triangle: its corners on the inner side of every edge, by
             // more than the snapping can move an edge.
@@ -474,7 +481,7 @@ TEST(DeferredShading, BinningSumsOverlapAreasOfSmallTrianglesOnTileAndViewportEd
             return pick == 3 ? N * unit(rng) : edge + 8.0 * (unit(rng) - 0.5);
         };
         mr::BinnedChunk chunk;
-        int missed = 0;  // triangles listed in a tile they cover none of
+        int straddling = 0;  // triangles listed in a tile their bounds reach past
         for (int k = 0; k < 6000; ++k) {
             std::array<glm::dvec2, 3> v;
             if (k % 10 == 9) {  // past corner c: its edge AB crosses the diagonal outside, 0.3 px from c
@@ -496,16 +503,17 @@ TEST(DeferredShading, BinningSumsOverlapAreasOfSmallTrianglesOnTileAndViewportEd
             const int x0 = tile % tiles * mr::kTileSize, y0 = tile / tiles * mr::kTileSize;
             double sum = 0.0;
             for (std::uint32_t i = chunk.tile_start[tile]; i < chunk.tile_start[tile + 1]; ++i) {
-                const double area = mr::tile_overlap_area(chunk.triangles[chunk.tile_triangles[i]], x0, y0,
-                                                          std::min(x0 + mr::kTileSize, N),
-                                                          std::min(y0 + mr::kTileSize, N));
-                missed += area == 0.0;
+                const mr::SetupTriangle& t = chunk.triangles[chunk.tile_triangles[i]];
+                const double area =
+                    mr::tile_overlap_area(t, x0, y0, std::min(x0 + mr::kTileSize, N), std::min(y0 + mr::kTileSize, N));
+                const int x1 = x0 + mr::kTileSize, y1 = y0 + mr::kTileSize;
+                straddling += t.min_x < x0 || t.min_y < y0 || t.max_x >= x1 || t.max_y >= y1;
                 sum += area;
             }
             EXPECT_EQ(chunk.tile_area[static_cast<std::size_t>(tile)], sum) << "tile " << tile;
         }
         EXPECT_GT(chunk.triangles.size(), 3500u);
-        EXPECT_GT(missed, 50);
+        EXPECT_GT(straddling, 500);
     }
 }
 
@@ -581,6 +589,33 @@ TEST(DeferredShading, BinningListsEveryTileItsTouchingTrianglesInOrder) {
     }
 }
 
+// A triangle no larger than a tile spread over the tiles its bounds reach: their estimates add up
+// to its area (the shoelace formula on its screen vertices, within their snapping), whichever tiles
+// it touches or misses; the binner's sums are these estimates (the tests above).
+TEST(DeferredShading, OverlapAreasOfASmallTriangleOverItsTilesAddUpToItsArea) {
+    std::mt19937_64 rng(46);
+    const int N = 256, T = mr::kTileSize;
+    int spanning = 0;
+    for (int k = 0; k < 40000; ++k) {
+        const double size = std::array<double, 4>{1.5, 4.0, 12.0, 30.0}[k % 4];
+        const std::array<glm::dvec2, 3> v = random_screen_triangle(rng, size, N);
+        mr::SetupTriangle t;
+        if (!set_up(v, N, t)) continue;
+        // Whole in the viewport, no larger than a tile, its bounds on more than one tile.
+        if (std::min({v[0].x, v[1].x, v[2].x, v[0].y, v[1].y, v[2].y}) < 1.0 ||
+            std::max({v[0].x, v[1].x, v[2].x, v[0].y, v[1].y, v[2].y}) > N - 1.0)
+            continue;
+        if (t.max_x + 1 - t.min_x > T || t.max_y + 1 - t.min_y > T) continue;
+        if (t.min_x / T == t.max_x / T && t.min_y / T == t.max_y / T) continue;
+        ++spanning;
+        double sum = 0.0;
+        for (int y0 = 0; y0 < N; y0 += T)
+            for (int x0 = 0; x0 < N; x0 += T) sum += mr::tile_overlap_area(t, x0, y0, x0 + T, y0 + T);
+        EXPECT_NEAR(sum, triangle_area(v), triangle_perimeter(v) / 256.0 + 1e-9) << "triangle of size " << size;
+    }
+    EXPECT_GT(spanning, 3000);
+}
+
 TEST(DeferredShading, OverlapAreaOfALargeTriangleIsItsAreaInsideTheRectangle) {
     std::mt19937_64 rng(45);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -598,8 +633,7 @@ TEST(DeferredShading, OverlapAreaOfALargeTriangleIsItsAreaInsideTheRectangle) {
         const double rect = double(x1 - x0) * double(y1 - y0);
         const double expected = triangle_in_rectangle(v, x0, y0, x1, y1);
         if (expected <= 0.0 || expected >= rect) continue;  // (missed or held whole: the other test)
-        double perimeter = 0.0;
-        for (int i = 0; i < 3; ++i) perimeter += glm::length(v[(i + 1) % 3] - v[i]);
+        const double perimeter = triangle_perimeter(v);
         // Snapping moves each edge by at most 1/256 px (with the top-left bias): the area inside the
         // rectangle by at most the edges' length inside it, bounded by its perimeter.
         const double slack = std::min(perimeter, 2.0 * (x1 - x0 + y1 - y0)) / 128.0 + 1e-9;

@@ -67,13 +67,21 @@ inline bool box_inside(const SetupTriangle& t, int x0, int y0, int x1, int y1) {
     return t.min_x > x0 && t.max_x + 1 < x1 && t.min_y > y0 && t.max_y + 1 < y1;
 }
 
+// A bounding box no wider and no taller than a tile, narrower or shorter than the rectangle: t is
+// small and cannot hold the rectangle, and its box share is estimate enough even where t misses
+// the rectangle (over the tiles its box reaches, the shares add up to its area).
+inline bool small_box_cannot_hold(const SetupTriangle& t, int x0, int y0, int x1, int y1) {
+    const int w = t.max_x + 1 - t.min_x, h = t.max_y + 1 - t.min_y;
+    return w <= kTileSize && h <= kTileSize && (w < x1 - x0 || h < y1 - y0);
+}
+
 }  // namespace
 
 double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1) {
     const int bx0 = std::max(t.min_x, x0), bx1 = std::min(t.max_x + 1, x1);
     const int by0 = std::max(t.min_y, y0), by1 = std::min(t.max_y + 1, y1);
     if (bx0 >= bx1 || by0 >= by1) return 0.0;
-    if (!box_inside(t, x0, y0, x1, y1)) {
+    if (!box_inside(t, x0, y0, x1, y1) && !small_box_cannot_hold(t, x0, y0, x1, y1)) {
         const kernels::SampleExtent extent{std::int64_t{x0} * kSubpixelOne, std::int64_t{y0} * kSubpixelOne,
                                            std::int64_t{x1} * kSubpixelOne - 1, std::int64_t{y1} * kSubpixelOne - 1};
         const kernels::BlockCoverage coverage = kernels::block_coverage(t, extent);
@@ -134,6 +142,10 @@ void ChunkBinner::finish() {
     std::vector<std::uint32_t> cursor(start.begin(), start.end() - 1);
     for (std::uint32_t i = 0; i < spans_.size(); ++i) {
         const TileSpan span = spans_[i];
+        if (span.x0 == span.x1 && span.y0 == span.y1) {  // (most small triangles: without the loops)
+            chunk_.tile_triangles[cursor[static_cast<std::size_t>(span.y0) * grid_.tiles_x + span.x0]++] = i;
+            continue;
+        }
         for (int ty = span.y0; ty <= span.y1; ++ty)
             for (int tx = span.x0; tx <= span.x1; ++tx)
                 chunk_.tile_triangles[cursor[static_cast<std::size_t>(ty) * grid_.tiles_x + tx]++] = i;

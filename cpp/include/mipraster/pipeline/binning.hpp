@@ -36,10 +36,13 @@ struct alignas(kBlockAlignment) BinnedChunk {
     bool one_draw = true;  ///< every triangle is of one draw (else a tile's list changes draw in runs)
 };
 
-/// About how many pixels of the rectangle [x0, x1) × [y0, y1) t covers: all of them when t holds
-/// the whole rectangle, none when it misses it, its area clipped to the rectangle when it is wider
-/// or taller than a tile, else its bounding box within the rectangle times the share of its whole
-/// bounding box it fills.
+/// About how many pixels of the rectangle [x0, x1) × [y0, y1) t covers: none when its bounding box
+/// misses the rectangle; else all of them when t holds the whole rectangle, none when it misses it,
+/// its area clipped to the rectangle when it is wider or taller than a tile, else its bounding box
+/// within the rectangle times the share of its whole bounding box it fills. That last estimate is
+/// also all that a triangle no wider and no taller than a tile gets where its box is narrower or
+/// shorter than the rectangle (it cannot hold it): over the tiles such a box reaches, the estimates
+/// add up to the triangle's area.
 double tile_overlap_area(const SetupTriangle& t, int x0, int y0, int x1, int y1);
 
 /// Bins a chunk while setup makes its triangles (a counting sort): add() counts each new
