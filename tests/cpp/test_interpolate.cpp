@@ -13,11 +13,13 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <glm/common.hpp>
 
 #include "helpers.hpp"
+#include "mipraster/pipeline/blend.hpp"
 #include "oracle.hpp"
 
 namespace {
@@ -445,6 +447,34 @@ TEST(Interpolate, FlatShadingUsesTheFirstVertexColourTimesTheDrawColour) {
 // ---------------------------------------------------------------------------------------------
 // Blending premultiplied colours
 // ---------------------------------------------------------------------------------------------
+
+// blend_into_samples against blend_into slot by slot: every mask of 16 slots (and the whole 64,
+// and random ones), each blend mode, slots outside the mask untouched, bit for bit.
+TEST(Interpolate, BlendingASamplesMaskIsBlendingEachOfItsSlots) {
+    std::mt19937_64 rng(12);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::vector<std::uint64_t> masks;
+    for (std::uint64_t m = 0; m < (1u << 16); ++m) masks.push_back(m);
+    masks.push_back(~std::uint64_t{0});
+    for (int k = 0; k < 2000; ++k) masks.push_back(rng() >> (rng() % 64));
+    std::vector<float> start(4 * 64), got, expected;
+    for (float& f : start) f = unit(rng);
+    const auto check = [&](auto mode) {
+        constexpr mr::BlendMode kMode = decltype(mode)::value;
+        for (const std::uint64_t m : masks) {
+            const glm::vec4 src(unit(rng), unit(rng), unit(rng), unit(rng));
+            got = expected = start;
+            mr::blend_into_samples<kMode>(got.data(), m, src);
+            for (int s = 0; s < 64; ++s)
+                if (m >> s & 1) mr::blend_into<kMode>(expected.data() + 4 * s, src);
+            ASSERT_EQ(std::memcmp(got.data(), expected.data(), 4 * 64 * sizeof(float)), 0)
+                << "mode " << static_cast<int>(kMode) << ", mask " << std::hex << m;
+        }
+    };
+    check(std::integral_constant<mr::BlendMode, mr::BlendMode::replace>{});
+    check(std::integral_constant<mr::BlendMode, mr::BlendMode::add>{});
+    check(std::integral_constant<mr::BlendMode, mr::BlendMode::over>{});
+}
 
 TEST(Interpolate, OverAndAddBlendingOfPremultipliedColoursFollowTheirFormulas) {
     // Identity camera; three overlapping triangles in 1/256 px units: a background drawn with

@@ -152,8 +152,7 @@ public:
                 blend_into<kBlend>(target, c);
                 continue;
             }
-            for (std::uint64_t m = pending_.samples[i]; m; m &= m - 1)
-                blend_into<kBlend>(target + 4 * __builtin_ctzll(m), c);
+            blend_into_samples<kBlend>(target, pending_.samples[i], c);
         }
         count_ = 0;
         // The current triangle stays, with nothing queued. (Its record is a few hundred bytes: a

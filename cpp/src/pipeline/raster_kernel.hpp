@@ -44,7 +44,7 @@ inline void shade_into(LookupQueue<kBlend, kShading, kTexturing>* queue, float* 
         }
     }
     const glm::vec4 c = shade<kShading, kTexturing>(draw, colors, uvs, t, screen, clip_weights, px, py);
-    for (std::uint64_t m = samples; m; m &= m - 1) blend_into<kBlend>(target + 4 * __builtin_ctzll(m), c);
+    blend_into_samples<kBlend>(target, samples, c);
 }
 
 // Untextured screen or perspective shading: a sample row's passed pixels are coloured a batch at
@@ -151,7 +151,7 @@ template <DepthFunc kDepth, BlendMode kBlend, Shading kShading, SampleMode kMode
             for (std::uint64_t m = samples; m; m &= m - 1) depth_px[__builtin_ctzll(m)] = depths[__builtin_ctzll(m)];
         }
         float* const color_px = target.color.at(px, py, 0);
-        for (std::uint64_t m = samples; m; m &= m - 1) blend_into<kBlend>(color_px + 4 * __builtin_ctzll(m), c);
+        blend_into_samples<kBlend>(color_px, samples, c);
     };
     // The shades waiting for a batch (with `sampler`): pixel and samples (screen weights in `weights`;
     // MSAA with a depth test: the samples' tested depths in waiting_depths).
