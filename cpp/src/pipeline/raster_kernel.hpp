@@ -506,6 +506,13 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         const auto record_owner = [&](int px, int py, std::uint64_t passed, bool at_centre) {
             const std::size_t first = target.owner_index(px, py, 0, S);
             const auto at = static_cast<std::uint8_t>(at_centre ? kShadeAtCentre : __builtin_ctzll(passed));
+            if (passed == 0xF) {  // (MSAA 4x, a pixel won whole, as most are: a store each, not a loop)
+                const std::int32_t owners[4] = {owner, owner, owner, owner};
+                const std::uint32_t places = at * 0x01010101u;
+                std::memcpy(target.owners + first, owners, sizeof owners);
+                std::memcpy(target.owner_shade_at + first, &places, sizeof places);
+                return;
+            }
             for (std::uint64_t m = passed; m; m &= m - 1) {
                 target.owners[first + __builtin_ctzll(m)] = owner;
                 target.owner_shade_at[first + __builtin_ctzll(m)] = at;
