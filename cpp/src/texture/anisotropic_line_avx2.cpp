@@ -108,12 +108,14 @@ struct FourLines {
     return f;
 }
 
-// Probe c of four lines: its quads' texels (where they start, in floats from each line's level's
-// first: four per texel, so that a load needs no shift; only corner 0 where the lines lie inside
-// their levels), [corner][line], and fractions, [line].
+// Probe c of four lines on each of two levels: its quads' texels (where they start, in floats from
+// each line's level's first: four per texel, so that a load needs no shift; only corner 0 where the
+// lines lie inside their levels), [level][corner][line], and fractions, [level][line]: a line's
+// two levels' fractions lie in one 32-byte row, so that one permute spreads them over the halves
+// of a register (see quads).
 struct ProbeSlot {
-    std::int32_t texel_float[4][4];
-    float fx[4], fy[4];
+    std::int32_t texel_float[2][4][4];
+    float fx[2][4], fy[2][4];
 };
 // Probes 0 … n − 1 of four lines (lines shorter than n get probes past their end, unread).
 struct FourProbes {
@@ -127,7 +129,8 @@ constexpr double kProbeNumbers[kMostVectorProbes] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 
 // texel is placed, ⌊y⌋·width + ⌊x⌋ in double (exact: below the level's texel count, which fits an
 // int); else all four, their indices wrapped.
 template <bool kInside>
-[[gnu::target("avx2")]] void place_probes(const FourLines& f, __m256d step, int n, const Sampler& s, FourProbes& p) {
+[[gnu::target("avx2")]] void place_probes(const FourLines& f, __m256d step, int n, const Sampler& s, int level,
+                                          FourProbes& p) {
     const __m256d width = _mm256_cvtepi32_pd(f.width);
     const __m128i one = _mm_set1_epi32(1);
     for (int c = 0; c < n; ++c) {
@@ -136,14 +139,14 @@ template <bool kInside>
         const __m256d x = _mm256_add_pd(f.x0, _mm256_mul_pd(t, f.sx));
         const __m256d y = _mm256_add_pd(f.y0, _mm256_mul_pd(t, f.sy));
         const __m256d fx = _mm256_floor_pd(x), fy = _mm256_floor_pd(y);
-        _mm_storeu_ps(at.fx, _mm256_cvtpd_ps(_mm256_sub_pd(x, fx)));
-        _mm_storeu_ps(at.fy, _mm256_cvtpd_ps(_mm256_sub_pd(y, fy)));
+        _mm_storeu_ps(at.fx[level], _mm256_cvtpd_ps(_mm256_sub_pd(x, fx)));
+        _mm_storeu_ps(at.fy[level], _mm256_cvtpd_ps(_mm256_sub_pd(y, fy)));
         // Past a line's end, or on a line the reference takes, a value may exceed the int range:
         // the conversion gives INT_MIN there (and the shifts and sums below wrap around, defined;
         // unread).
         if constexpr (kInside) {  // (the other corners follow from the first: see quad)
             const __m128i texel = _mm256_cvttpd_epi32(_mm256_add_pd(_mm256_mul_pd(fy, width), fx));
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(at.texel_float[0]), _mm_slli_epi32(texel, 2));
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(at.texel_float[level][0]), _mm_slli_epi32(texel, 2));
             continue;
         }
         const __m128i i0 = _mm256_cvttpd_epi32(fx), j0 = _mm256_cvttpd_epi32(fy);
@@ -155,26 +158,28 @@ template <bool kInside>
         const __m128i texel[4] = {_mm_add_epi32(row0, i), _mm_add_epi32(row0, i1), _mm_add_epi32(row1, i),
                                   _mm_add_epi32(row1, i1)};
         for (int corner = 0; corner < 4; ++corner)
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(at.texel_float[corner]), _mm_slli_epi32(texel[corner], 2));
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(at.texel_float[level][corner]),
+                             _mm_slli_epi32(texel[corner], 2));
     }
 }
 
-// The bilinear quad of probe `at` on line j, on a level whose texels' floats start at t and whose
-// rows are `row` floats long. kInside: the group's lines lie inside their levels, and only each
-// quad's first texel was placed; the others are the next one and the two below them.
+// The bilinear quad of probe `at` on line j of the finer level, whose texels' floats start at t and
+// whose rows are `row` floats long. kInside: the group's lines lie inside their levels, and only
+// each quad's first texel was placed; the others are the next one and the two below them.
 template <bool kInside>
 [[gnu::target("avx2")]] inline Texel quad(const float* t, const ProbeSlot& at, int j, std::ptrdiff_t row) {
+    const auto& texel = at.texel_float[0];
     if constexpr (kInside) {
-        const float* a = t + at.texel_float[0][j];
-        return lerp_quad(load(a), load(a + 4), load(a + row), load(a + row + 4), at.fx[j], at.fy[j]);
+        const float* a = t + texel[0][j];
+        return lerp_quad(load(a), load(a + 4), load(a + row), load(a + row + 4), at.fx[0][j], at.fy[0][j]);
     }
-    return lerp_quad(load(t + at.texel_float[0][j]), load(t + at.texel_float[1][j]), load(t + at.texel_float[2][j]),
-                     load(t + at.texel_float[3][j]), at.fx[j], at.fy[j]);
+    return lerp_quad(load(t + texel[0][j]), load(t + texel[1][j]), load(t + texel[2][j]), load(t + texel[3][j]),
+                     at.fx[0][j], at.fy[0][j]);
 }
 
-// The mean of line j's probes 0 … count − 1 on a level (floats t, rows `row` floats long), as the
-// reference adds them: the first quad plus the mean difference of the others from it (so that a
-// constant texture gives back its value exactly).
+// The mean of line j's probes 0 … count − 1 on the finer level (floats t, rows `row` floats long),
+// as the reference adds them: the first quad plus the mean difference of the others from it (so
+// that a constant texture gives back its value exactly).
 template <bool kInside>
 [[gnu::target("avx2")]] inline Texel line_mean(const float* t, const FourProbes& p, std::ptrdiff_t row, int j,
                                                int count, float step) {
@@ -192,38 +197,40 @@ template <bool kInside>
 [[gnu::target("avx2")]] inline __m256 lerp_pair(__m256 a, __m256 b, __m256 t) {
     return _mm256_add_ps(a, _mm256_mul_ps(t, _mm256_sub_ps(b, a)));
 }
-[[gnu::target("avx2")]] inline __m256 halves(float finer, float coarser) {
-    return _mm256_set_m128(_mm_set1_ps(coarser), _mm_set1_ps(finer));
+// Line j's fraction of both levels, fraction[0][j] and fraction[1][j], each over its half of a
+// register: `spread` is (j, j, j, j, j + 4, j + 4, j + 4, j + 4).
+[[gnu::target("avx2")]] inline __m256 halves(const float (&fraction)[2][4], __m256i spread) {
+    return _mm256_permutevar8x32_ps(_mm256_loadu_ps(fraction[0]), spread);
 }
 
-// The quads of probe pa and pb on line j of two levels (finer level ta, coarser tb) at once, as
+// The quads of probe `at` on line j of two levels (finer level ta, coarser tb) at once, as
 // quad<kInside> on each.
 template <bool kInside>
-[[gnu::target("avx2")]] inline __m256 quads(const float* ta, const ProbeSlot& pa, std::ptrdiff_t ra, const float* tb,
-                                            const ProbeSlot& pb, std::ptrdiff_t rb, int j) {
+[[gnu::target("avx2")]] inline __m256 quads(const float* ta, std::ptrdiff_t ra, const float* tb, std::ptrdiff_t rb,
+                                            const ProbeSlot& at, int j, __m256i spread) {
+    const auto &finer = at.texel_float[0], &coarser = at.texel_float[1];
     __m256 corner[4];
     if constexpr (kInside) {
-        const float *a = ta + pa.texel_float[0][j], *b = tb + pb.texel_float[0][j];
+        const float *a = ta + finer[0][j], *b = tb + coarser[0][j];
         corner[0] = pair(a, b), corner[1] = pair(a + 4, b + 4);
         corner[2] = pair(a + ra, b + rb), corner[3] = pair(a + ra + 4, b + rb + 4);
     } else {
-        for (int k = 0; k < 4; ++k) corner[k] = pair(ta + pa.texel_float[k][j], tb + pb.texel_float[k][j]);
+        for (int k = 0; k < 4; ++k) corner[k] = pair(ta + finer[k][j], tb + coarser[k][j]);
     }
-    const __m256 fx = halves(pa.fx[j], pb.fx[j]);
-    return lerp_pair(lerp_pair(corner[0], corner[1], fx), lerp_pair(corner[2], corner[3], fx),
-                     halves(pa.fy[j], pb.fy[j]));
+    const __m256 fx = halves(at.fx, spread);
+    return lerp_pair(lerp_pair(corner[0], corner[1], fx), lerp_pair(corner[2], corner[3], fx), halves(at.fy, spread));
 }
 
 // line_mean on two levels at once, each level's sum in its own half of a register (the same bits
 // as one level at a time, half the instructions): the finer level's mean in the low half.
 template <bool kInside>
-[[gnu::target("avx2")]] inline __m256 line_means(const float* ta, const FourProbes& pa, std::ptrdiff_t ra,
-                                                 const float* tb, const FourProbes& pb, std::ptrdiff_t rb, int j,
-                                                 int count, float step) {
-    const __m256 first = quads<kInside>(ta, pa.at[0], ra, tb, pb.at[0], rb, j);
+[[gnu::target("avx2")]] inline __m256 line_means(const float* ta, std::ptrdiff_t ra, const float* tb, std::ptrdiff_t rb,
+                                                 const FourProbes& p, int j, int count, float step) {
+    const __m256i spread = _mm256_add_epi32(_mm256_set1_epi32(j), _mm256_setr_epi32(0, 0, 0, 0, 4, 4, 4, 4));
+    const __m256 first = quads<kInside>(ta, ra, tb, rb, p.at[0], j, spread);
     __m256 difference = _mm256_setzero_ps();
     for (int k = 1; k < count; ++k) {
-        const __m256 probe = quads<kInside>(ta, pa.at[k], ra, tb, pb.at[k], rb, j);
+        const __m256 probe = quads<kInside>(ta, ra, tb, rb, p.at[k], j, spread);
         difference = _mm256_add_ps(difference, _mm256_sub_ps(probe, first));
     }
     return _mm256_add_ps(first, _mm256_mul_ps(difference, _mm256_set1_ps(step)));
@@ -271,9 +278,9 @@ template <bool kInside>
     int longest = 0;
     for (int j = 0; j < n; ++j)
         if (vector_lanes >> j & 1) longest = std::max(longest, lanes.count[first + j]);
-    FourProbes probes[2];
+    FourProbes probes;
     for (int k = 0; k < (two_levels ? 2 : 1); ++k)
-        (inside ? place_probes<true> : place_probes<false>)(lines[k], step, longest, s, probes[k]);
+        (inside ? place_probes<true> : place_probes<false>)(lines[k], step, longest, s, k, probes);
 
     alignas(32) double steps[4];
     _mm256_store_pd(steps, step);
@@ -289,17 +296,16 @@ template <bool kInside>
         if (two_levels) {
             const float* coarser = &level[1][j]->texels.data()->x;
             const std::ptrdiff_t coarser_row = std::ptrdiff_t{4} * level[1][j]->width;
-            const __m256 means = inside ? line_means<true>(finer, probes[0], finer_row, coarser, probes[1], coarser_row,
-                                                           j, probes_j, step_j)
-                                        : line_means<false>(finer, probes[0], finer_row, coarser, probes[1],
-                                                            coarser_row, j, probes_j, step_j);
+            const __m256 means =
+                inside ? line_means<true>(finer, finer_row, coarser, coarser_row, probes, j, probes_j, step_j)
+                       : line_means<false>(finer, finer_row, coarser, coarser_row, probes, j, probes_j, step_j);
             const Texel finer_mean = Texel(_mm256_castps256_ps128(means));
             out[lanes.out[i]] = to_vec4(lanes.coarser[i] ? lerp(finer_mean, Texel(_mm256_extractf128_ps(means, 1)),
                                                                 lanes.weight[i])
                                                          : finer_mean);
         } else {
-            out[lanes.out[i]] = to_vec4(inside ? line_mean<true>(finer, probes[0], finer_row, j, probes_j, step_j)
-                                               : line_mean<false>(finer, probes[0], finer_row, j, probes_j, step_j));
+            out[lanes.out[i]] = to_vec4(inside ? line_mean<true>(finer, probes, finer_row, j, probes_j, step_j)
+                                               : line_mean<false>(finer, probes, finer_row, j, probes_j, step_j));
         }
     }
 }
