@@ -303,6 +303,25 @@ namespace {
     if (S == 4) {  // (MSAA 4x) one vector a pixel, its samples' edge values stepped directly
         __m256d d[3];
         for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(pixel[i], _mm256_loadu_pd(offsets[i]));
+        // Along the row each sample's edge values move by a constant (exact integers): when the
+        // first and the last pixel have all four samples inside, so has every pixel between, and
+        // the row needs only the depth tests (the inside of a large triangle).
+        __m256d inside = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+        const __m256d last = _mm256_set1_pd(n - 1);
+        for (int i = 0; i < 3; ++i)
+            inside = _mm256_and_pd(inside, _mm256_and_pd(_mm256_cmp_pd(d[i], bias[i], _CMP_GE_OQ),
+                                                         _mm256_cmp_pd(_mm256_add_pd(d[i], _mm256_mul_pd(last, step[i])),
+                                                                       bias[i], _CMP_GE_OQ)));
+        if (n > 0 && _mm256_movemask_pd(inside) == 15) {
+            found.covered = 4 * static_cast<std::uint64_t>(n);
+            for (int j = 0; j < n; ++j) {
+                const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
+                float* const tested = tested_depths ? tested_depths + 4 * j : nullptr;
+                record(j, test_four_depths(plane, l1, l2, 15, func, depth_write, depth + 4 * j, tested));
+                d[1] = _mm256_add_pd(d[1], step[1]), d[2] = _mm256_add_pd(d[2], step[2]);
+            }
+            return found;
+        }
         for (int j = 0; j < n; ++j) {
             record(j, four_samples(d, bias, inv_area2, plane, func, depth_write, depth, tested_depths, 4 * j,
                                    found.covered));
