@@ -144,18 +144,37 @@ struct FourPixels {
     std::uint32_t inside;
 };
 
+// kInside: the row is known to lie inside the triangle (row_inside), so the tests are left out.
+template <bool kInside>
 [[gnu::always_inline]] [[gnu::target("avx2")]] inline void four_pixels(const RowTerms& k, const __m256d (&first)[3],
                                                                       const __m256d& x, FourPixels& p) {
     __m256d d[3];
     for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(first[i], _mm256_mul_pd(x, k.step[i]));
-    const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], k.bias[0], _CMP_GE_OQ),
-                                                       _mm256_cmp_pd(d[1], k.bias[1], _CMP_GE_OQ)),
-                                         _mm256_cmp_pd(d[2], k.bias[2], _CMP_GE_OQ));
     p.l0 = _mm256_mul_pd(d[0], k.inv_area2), p.l1 = _mm256_mul_pd(d[1], k.inv_area2);
     p.l2 = _mm256_mul_pd(d[2], k.inv_area2);
     p.depths = _mm256_cvtpd_ps(
         _mm256_add_pd(_mm256_add_pd(k.z0, _mm256_mul_pd(p.l1, k.dz1)), _mm256_mul_pd(p.l2, k.dz2)));
-    p.inside = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
+    if constexpr (kInside) {
+        p.inside = 15;
+    } else {
+        const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], k.bias[0], _CMP_GE_OQ),
+                                                           _mm256_cmp_pd(d[1], k.bias[1], _CMP_GE_OQ)),
+                                             _mm256_cmp_pd(d[2], k.bias[2], _CMP_GE_OQ));
+        p.inside = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
+    }
+}
+
+// Whether all n pixels of a sample's row (edge values plus bias `first` at its first pixel) are
+// inside the triangle: the values are exact integers moving by a constant along the row, so its
+// first and last pixel bound every one between.
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline bool row_inside(const RowTerms& k, const __m256d (&first)[3],
+                                                                     int n) {
+    const __m256d ends = _mm256_setr_pd(0.0, n - 1.0, 0.0, n - 1.0);
+    __m256d inside = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+    for (int i = 0; i < 3; ++i)
+        inside = _mm256_and_pd(inside, _mm256_cmp_pd(_mm256_add_pd(first[i], _mm256_mul_pd(ends, k.step[i])),
+                                                     k.bias[i], _CMP_GE_OQ));
+    return _mm256_movemask_pd(inside) == 15;
 }
 
 // All bits of lane k where bit k of `bits` is set (k < 4).
@@ -184,7 +203,7 @@ struct FourPixels {
     __m256d x = _mm256_set_pd(3.0, 2.0, 1.0, 0.0);
     for (int j = 0; j < n; j += 4, x = _mm256_add_pd(x, four)) {
         FourPixels p;
-        four_pixels(k, first, x, p);
+        four_pixels<false>(k, first, x, p);
         const int lanes = n - j < 4 ? n - j : 4;
         const std::uint32_t covered = p.inside & ((1u << lanes) - 1u);
         out.covered |= covered << j;
@@ -205,20 +224,16 @@ struct FourPixels {
     return true;
 }
 
-// test_sample_row_avx2 for four samples at once: per sample the same operations; the depths of
-// four pixels are read and written as four vectors of four samples, transposed in registers.
-[[gnu::target("avx2")]] bool test_four_sample_rows_avx2(const SetupTriangle& t, const std::int64_t (&e)[4][3], int n,
-                                                        std::uint32_t tested, DepthFunc func, bool depth_write,
-                                                        float* depth, int stride, SampleRow (&out)[4]) {
-    for (int s = 0; s < 4; ++s)
-        if (!exact_row(t, e[s], n)) return false;
-    RowTerms k;
-    splat_row_terms(t, k);
-    __m256d first[4][3];
-    for (int s = 0; s < 4; ++s)
-        for (int i = 0; i < 3; ++i) first[s][i] = _mm256_set1_pd(static_cast<double>(e[s][i] + t.bias[i]));
-    const bool greater = func == DepthFunc::greater;
-    for (SampleRow& row : out) row.covered = row.passed = 0;
+namespace {
+
+// test_four_sample_rows_avx2's loop over the rows' pixels, four at a time (kInside: row_inside
+// holds for all four samples).
+template <bool kInside>
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline void four_sample_rows(const RowTerms& k,
+                                                                           const __m256d (&first)[4][3], int n,
+                                                                           std::uint32_t tested, bool greater,
+                                                                           bool depth_write, float* depth, int stride,
+                                                                           SampleRow (&out)[4]) {
     const __m256d four = _mm256_set1_pd(4.0);
     __m256d x = _mm256_set_pd(3.0, 2.0, 1.0, 0.0);
     for (int j = 0; j < n; j += 4, x = _mm256_add_pd(x, four)) {
@@ -226,7 +241,7 @@ struct FourPixels {
         FourPixels p[4];
         std::uint32_t asked[4], any_asked = 0;
         for (int s = 0; s < 4; ++s) {
-            four_pixels(k, first[s], x, p[s]);
+            four_pixels<kInside>(k, first[s], x, p[s]);
             const std::uint32_t covered = p[s].inside & ((1u << lanes) - 1u);
             out[s].covered |= covered << j;
             asked[s] = covered & (tested >> j);
@@ -255,6 +270,30 @@ struct FourPixels {
         _MM_TRANSPOSE4_PS(stored[0], stored[1], stored[2], stored[3]);
         for (int q = 0; q < lanes; ++q) _mm_storeu_ps(pixels + q * stride, stored[q]);
     }
+}
+
+}  // namespace
+
+// test_sample_row_avx2 for four samples at once: per sample the same operations; the depths of
+// four pixels are read and written as four vectors of four samples, transposed in registers.
+[[gnu::target("avx2")]] bool test_four_sample_rows_avx2(const SetupTriangle& t, const std::int64_t (&e)[4][3], int n,
+                                                        std::uint32_t tested, DepthFunc func, bool depth_write,
+                                                        float* depth, int stride, SampleRow (&out)[4]) {
+    for (int s = 0; s < 4; ++s)
+        if (!exact_row(t, e[s], n)) return false;
+    RowTerms k;
+    splat_row_terms(t, k);
+    __m256d first[4][3];
+    for (int s = 0; s < 4; ++s)
+        for (int i = 0; i < 3; ++i) first[s][i] = _mm256_set1_pd(static_cast<double>(e[s][i] + t.bias[i]));
+    const bool greater = func == DepthFunc::greater;
+    for (SampleRow& row : out) row.covered = row.passed = 0;
+    bool inside = n > 0;
+    for (int s = 0; s < 4 && inside; ++s) inside = row_inside(k, first[s], n);
+    if (inside)
+        four_sample_rows<true>(k, first, n, tested, greater, depth_write, depth, stride, out);
+    else
+        four_sample_rows<false>(k, first, n, tested, greater, depth_write, depth, stride, out);
     return true;
 }
 
@@ -262,36 +301,56 @@ namespace {
 
 // test_pixel_row_avx2's step for four samples of a pixel at edge values d (exact integers, bias
 // added): `covered` counts those inside; their depth test against depth[at … at + 3] (the
-// computed depths into tested[at … at + 3] where it is not null). Returns the passed ones. (A
+// computed depths into tested[at … at + 3] where it is not null). Returns the passed ones.
+// kInside: all four are known to be inside (inside_along), and the edge tests are left out. (A
 // function, not a lambda: a lambda does not take its function's target, and a baseline build
 // could not inline the intrinsics into it.)
+template <bool kInside>
 [[gnu::always_inline]] [[gnu::target("avx2")]] inline std::uint32_t four_samples(
     const __m256d (&d)[3], const __m256d (&bias)[3], __m256d inv_area2, const DepthPlane4& plane, DepthFunc func,
     bool depth_write, float* depth, float* tested, std::ptrdiff_t at, std::uint64_t& covered) {
-    const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
-                                                       _mm256_cmp_pd(d[1], bias[1], _CMP_GE_OQ)),
-                                         _mm256_cmp_pd(d[2], bias[2], _CMP_GE_OQ));
-    const auto lanes = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
+    std::uint32_t lanes = 15;
+    if constexpr (!kInside) {
+        const __m256d inside = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(d[0], bias[0], _CMP_GE_OQ),
+                                                           _mm256_cmp_pd(d[1], bias[1], _CMP_GE_OQ)),
+                                             _mm256_cmp_pd(d[2], bias[2], _CMP_GE_OQ));
+        lanes = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
+    }
     covered += static_cast<std::uint64_t>(__builtin_popcount(lanes));
     if (!lanes) return 0;
     const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
     return test_four_depths(plane, l1, l2, lanes, func, depth_write, depth + at, tested ? tested + at : nullptr);
 }
 
-}  // namespace
-
-[[gnu::target("avx2")]] PixelRowTest test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&corner)[3],
-                                                         int n, const double* const (&offsets)[3], int S,
-                                                         DepthFunc func, bool depth_write, float* depth,
-                                                         std::uint64_t* samples, float* tested_depths) {
-    __m256d pixel[3], step[3], bias[3];
+// Whether four samples with edge values plus bias d at a row's first pixel are inside the
+// triangle at all n pixels: along the row the values are exact integers moving by a constant, so
+// the first and the last pixel bound every one between (the inside of a large triangle).
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline bool inside_along(const __m256d (&d)[3],
+                                                                       const __m256d (&step)[3],
+                                                                       const __m256d (&bias)[3], int n) {
+    const __m256d last = _mm256_set1_pd(n - 1.0);
+    __m256d inside = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
     for (int i = 0; i < 3; ++i) {
-        pixel[i] = _mm256_set1_pd(static_cast<double>(corner[i] + t.bias[i]));
-        step[i] = _mm256_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
-        bias[i] = _mm256_set1_pd(static_cast<double>(t.bias[i]));
+        const __m256d at_last = _mm256_add_pd(d[i], _mm256_mul_pd(last, step[i]));
+        inside = _mm256_and_pd(inside, _mm256_and_pd(_mm256_cmp_pd(d[i], bias[i], _CMP_GE_OQ),
+                                                     _mm256_cmp_pd(at_last, bias[i], _CMP_GE_OQ)));
     }
-    const __m256d inv_area2 = _mm256_set1_pd(t.inv_area2);
-    const DepthPlane4 plane = depth_plane4(t);
+    return n > 0 && _mm256_movemask_pd(inside) == 15;
+}
+
+// A row's edge terms, as test_pixel_row_avx2 steps them.
+struct PixelRowTerms {
+    __m256d pixel[3], step[3], bias[3], inv_area2;
+    DepthPlane4 plane;
+};
+
+// test_pixel_row_avx2's loop over the pixels (kInside: every sample of the row is inside).
+template <bool kInside>
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline PixelRowTest pixel_row(const PixelRowTerms& k, int n,
+                                                                            const double* const (&offsets)[3], int S,
+                                                                            DepthFunc func, bool depth_write,
+                                                                            float* depth, std::uint64_t* samples,
+                                                                            float* tested_depths) {
     PixelRowTest found;
     const auto record = [&](int j, std::uint64_t passed) {
         samples[j] = passed;
@@ -302,47 +361,53 @@ namespace {
     // integers (below 2^52), are the same doubles in any order of the sums.
     if (S == 4) {  // (MSAA 4x) one vector a pixel, its samples' edge values stepped directly
         __m256d d[3];
-        for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(pixel[i], _mm256_loadu_pd(offsets[i]));
-        // Along the row each sample's edge values move by a constant (exact integers): when the
-        // first and the last pixel have all four samples inside, so has every pixel between, and
-        // the row needs only the depth tests (the inside of a large triangle).
-        __m256d inside = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
-        const __m256d last = _mm256_set1_pd(n - 1);
-        for (int i = 0; i < 3; ++i)
-            inside = _mm256_and_pd(inside, _mm256_and_pd(_mm256_cmp_pd(d[i], bias[i], _CMP_GE_OQ),
-                                                         _mm256_cmp_pd(_mm256_add_pd(d[i], _mm256_mul_pd(last, step[i])),
-                                                                       bias[i], _CMP_GE_OQ)));
-        if (n > 0 && _mm256_movemask_pd(inside) == 15) {
-            found.covered = 4 * static_cast<std::uint64_t>(n);
-            for (int j = 0; j < n; ++j) {
-                const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
-                float* const tested = tested_depths ? tested_depths + 4 * j : nullptr;
-                record(j, test_four_depths(plane, l1, l2, 15, func, depth_write, depth + 4 * j, tested));
-                d[1] = _mm256_add_pd(d[1], step[1]), d[2] = _mm256_add_pd(d[2], step[2]);
-            }
-            return found;
-        }
+        for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(k.pixel[i], _mm256_loadu_pd(offsets[i]));
         for (int j = 0; j < n; ++j) {
-            record(j, four_samples(d, bias, inv_area2, plane, func, depth_write, depth, tested_depths, 4 * j,
-                                   found.covered));
-            for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(d[i], step[i]);
+            record(j, four_samples<kInside>(d, k.bias, k.inv_area2, k.plane, func, depth_write, depth, tested_depths,
+                                            4 * j, found.covered));
+            for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(d[i], k.step[i]);
         }
         return found;
     }
+    __m256d pixel[3] = {k.pixel[0], k.pixel[1], k.pixel[2]};
     for (int j = 0; j < n; ++j) {
         std::uint64_t passed = 0;
         for (int g = 0; g < S; g += 4) {
             __m256d d[3];
             for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(pixel[i], _mm256_loadu_pd(offsets[i] + g));
             const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(j) * S + g;
-            passed |= std::uint64_t{four_samples(d, bias, inv_area2, plane, func, depth_write, depth, tested_depths,
-                                                 at, found.covered)}
+            passed |= std::uint64_t{four_samples<kInside>(d, k.bias, k.inv_area2, k.plane, func, depth_write, depth,
+                                                          tested_depths, at, found.covered)}
                       << g;
         }
         record(j, passed);
-        for (int i = 0; i < 3; ++i) pixel[i] = _mm256_add_pd(pixel[i], step[i]);
+        for (int i = 0; i < 3; ++i) pixel[i] = _mm256_add_pd(pixel[i], k.step[i]);
     }
     return found;
+}
+
+}  // namespace
+
+[[gnu::target("avx2")]] PixelRowTest test_pixel_row_avx2(const SetupTriangle& t, const std::int64_t (&corner)[3],
+                                                         int n, const double* const (&offsets)[3], int S,
+                                                         DepthFunc func, bool depth_write, float* depth,
+                                                         std::uint64_t* samples, float* tested_depths) {
+    PixelRowTerms k;
+    for (int i = 0; i < 3; ++i) {
+        k.pixel[i] = _mm256_set1_pd(static_cast<double>(corner[i] + t.bias[i]));
+        k.step[i] = _mm256_set1_pd(static_cast<double>(std::int64_t{t.edge_a[i]} * kSubpixelOne));
+        k.bias[i] = _mm256_set1_pd(static_cast<double>(t.bias[i]));
+    }
+    k.inv_area2 = _mm256_set1_pd(t.inv_area2);
+    k.plane = depth_plane4(t);
+    bool inside = true;
+    for (int g = 0; g < S && inside; g += 4) {
+        __m256d d[3];
+        for (int i = 0; i < 3; ++i) d[i] = _mm256_add_pd(k.pixel[i], _mm256_loadu_pd(offsets[i] + g));
+        inside = inside_along(d, k.step, k.bias, n);
+    }
+    return inside ? pixel_row<true>(k, n, offsets, S, func, depth_write, depth, samples, tested_depths)
+                  : pixel_row<false>(k, n, offsets, S, func, depth_write, depth, samples, tested_depths);
 }
 
 namespace {
