@@ -121,6 +121,23 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
 
 namespace {
 
+// Whether the samples with edge values plus bias d at a row's first pixel (four, or one in every
+// lane) are inside the triangle at all n pixels: along the row the values are exact integers moving
+// by a constant, so the first and the last pixel bound every one between (the inside of a large
+// triangle).
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline bool inside_along(const __m256d (&d)[3],
+                                                                       const __m256d (&step)[3],
+                                                                       const __m256d (&bias)[3], int n) {
+    const __m256d last = _mm256_set1_pd(n - 1.0);
+    __m256d inside = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+    for (int i = 0; i < 3; ++i) {
+        const __m256d at_last = _mm256_add_pd(d[i], _mm256_mul_pd(last, step[i]));
+        inside = _mm256_and_pd(inside, _mm256_and_pd(_mm256_cmp_pd(d[i], bias[i], _CMP_GE_OQ),
+                                                     _mm256_cmp_pd(at_last, bias[i], _CMP_GE_OQ)));
+    }
+    return n > 0 && _mm256_movemask_pd(inside) == 15;
+}
+
 // test_sample_row_avx2's per-triangle terms, one value in every lane.
 struct RowTerms {
     __m256d step[3], bias[3], inv_area2, z0, dz1, dz2;
@@ -144,7 +161,7 @@ struct FourPixels {
     std::uint32_t inside;
 };
 
-// kInside: the row is known to lie inside the triangle (row_inside), so the tests are left out.
+// kInside: the row is known to lie inside the triangle (inside_along), so the tests are left out.
 template <bool kInside>
 [[gnu::always_inline]] [[gnu::target("avx2")]] inline void four_pixels(const RowTerms& k, const __m256d (&first)[3],
                                                                       const __m256d& x, FourPixels& p) {
@@ -162,19 +179,6 @@ template <bool kInside>
                                              _mm256_cmp_pd(d[2], k.bias[2], _CMP_GE_OQ));
         p.inside = static_cast<std::uint32_t>(_mm256_movemask_pd(inside));
     }
-}
-
-// Whether all n pixels of a sample's row (edge values plus bias `first` at its first pixel) are
-// inside the triangle: the values are exact integers moving by a constant along the row, so its
-// first and last pixel bound every one between.
-[[gnu::always_inline]] [[gnu::target("avx2")]] inline bool row_inside(const RowTerms& k, const __m256d (&first)[3],
-                                                                     int n) {
-    const __m256d ends = _mm256_setr_pd(0.0, n - 1.0, 0.0, n - 1.0);
-    __m256d inside = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
-    for (int i = 0; i < 3; ++i)
-        inside = _mm256_and_pd(inside, _mm256_cmp_pd(_mm256_add_pd(first[i], _mm256_mul_pd(ends, k.step[i])),
-                                                     k.bias[i], _CMP_GE_OQ));
-    return _mm256_movemask_pd(inside) == 15;
 }
 
 // All bits of lane k where bit k of `bits` is set (k < 4).
@@ -226,7 +230,7 @@ template <bool kInside>
 
 namespace {
 
-// test_four_sample_rows_avx2's loop over the rows' pixels, four at a time (kInside: row_inside
+// test_four_sample_rows_avx2's loop over the rows' pixels, four at a time (kInside: inside_along
 // holds for all four samples).
 template <bool kInside>
 [[gnu::always_inline]] [[gnu::target("avx2")]] inline void four_sample_rows(const RowTerms& k,
@@ -288,8 +292,8 @@ template <bool kInside>
         for (int i = 0; i < 3; ++i) first[s][i] = _mm256_set1_pd(static_cast<double>(e[s][i] + t.bias[i]));
     const bool greater = func == DepthFunc::greater;
     for (SampleRow& row : out) row.covered = row.passed = 0;
-    bool inside = n > 0;
-    for (int s = 0; s < 4 && inside; ++s) inside = row_inside(k, first[s], n);
+    bool inside = true;
+    for (int s = 0; s < 4 && inside; ++s) inside = inside_along(first[s], k.step, k.bias, n);
     if (inside)
         four_sample_rows<true>(k, first, n, tested, greater, depth_write, depth, stride, out);
     else
@@ -320,22 +324,6 @@ template <bool kInside>
     if (!lanes) return 0;
     const __m256d l1 = _mm256_mul_pd(d[1], inv_area2), l2 = _mm256_mul_pd(d[2], inv_area2);
     return test_four_depths(plane, l1, l2, lanes, func, depth_write, depth + at, tested ? tested + at : nullptr);
-}
-
-// Whether four samples with edge values plus bias d at a row's first pixel are inside the
-// triangle at all n pixels: along the row the values are exact integers moving by a constant, so
-// the first and the last pixel bound every one between (the inside of a large triangle).
-[[gnu::always_inline]] [[gnu::target("avx2")]] inline bool inside_along(const __m256d (&d)[3],
-                                                                       const __m256d (&step)[3],
-                                                                       const __m256d (&bias)[3], int n) {
-    const __m256d last = _mm256_set1_pd(n - 1.0);
-    __m256d inside = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
-    for (int i = 0; i < 3; ++i) {
-        const __m256d at_last = _mm256_add_pd(d[i], _mm256_mul_pd(last, step[i]));
-        inside = _mm256_and_pd(inside, _mm256_and_pd(_mm256_cmp_pd(d[i], bias[i], _CMP_GE_OQ),
-                                                     _mm256_cmp_pd(at_last, bias[i], _CMP_GE_OQ)));
-    }
-    return n > 0 && _mm256_movemask_pd(inside) == 15;
 }
 
 // A row's edge terms, as test_pixel_row_avx2 steps them.
