@@ -528,6 +528,83 @@ TEST(Renderer, EveryPathWritesEveryPixelOfTheUnfilledColourImage) {
         }
 }
 
+// Where every draw tests and writes depth and replaces colour, the renderer clears a tile's colour
+// after drawing, only at the samples still at the clear depth (fill_undrawn). The image, depth and
+// counters must be those of a clear before drawing: of the same scene with a no-op draw (one
+// triangle off the screen, blending add, no depth test) that breaks the condition, and of the
+// kept-samples path, which starts from a cleared framebuffer. Scenes whose draws break it
+// themselves (a draw blending over, one not writing depth, one not testing it) must match the
+// kept-samples path too. Random overlapping triangles leave background in most tiles; partial
+// tiles; textured, alpha-tested and untextured draws; both depth conventions; every sample mode;
+// deferred shading on and off, listed pixels and the error estimate (which reads the samples);
+// one and two threads. The clear colour holds a −0 and a subnormal, which a resolve keeps.
+TEST(Renderer, ColourClearedAfterDrawingGivesTheImageOfTheClearBefore) {
+    const int W = 100, H = 70;
+    const mr::Mesh a = overlapping(60, 1.2, 31), b = overlapping(40, 0.8, 32);
+    const mr::Mesh off_screen = helpers::random_triangles(1, 0.1, 33, {50.0, 50.0, 0.0}, {1.0, 1.0, 1.0});
+    const mr::Texture texture = checker_texture();
+    glm::dmat4 shifted(1.0);
+    shifted[3] = glm::dvec4(0.4, -0.2, 0.3, 1.0);
+    mr::DrawState cut, over, read_only, untested;
+    cut.alpha_cutoff = 0.5f;
+    over.blend = mr::BlendMode::over;
+    read_only.depth_write = false;
+    untested.depth_test = false;  // (depth_write on, but an untested draw stores no depth)
+    std::vector<std::uint32_t> pixels;
+    for (std::uint32_t i = 0; i < std::uint32_t(W * H); i += 2) pixels.push_back(i);
+    const std::pair<mr::AntiAliasing, int> modes[] = {{mr::AntiAliasing::ssaa, 1}, {mr::AntiAliasing::ssaa, 4},
+                                                      {mr::AntiAliasing::msaa, 4}, {mr::AntiAliasing::msaa, 16}};
+    const mr::DrawState last_states[] = {mr::DrawState{}, over, read_only, untested};  // [0]: cleared after
+    // (With listed pixels the kept-samples path draws whole tiles, the other only the pixels'
+    // spans: their counters differ.)
+    const auto same = [](const mr::RenderResult& r, const mr::RenderResult& before, bool counters) {
+        EXPECT_TRUE(same_bits(r.color.pixels, before.color.pixels)) << "colour differs";
+        EXPECT_TRUE(same_bits(r.depth.pixels, before.depth.pixels)) << "depth differs";
+        EXPECT_TRUE(same_bits(r.error_map.pixels, before.error_map.pixels)) << "error map differs";
+        if (!counters) return;
+        EXPECT_EQ(r.stats.samples_covered, before.stats.samples_covered);
+        EXPECT_EQ(r.stats.samples_passed, before.stats.samples_passed);
+        EXPECT_EQ(r.stats.shader_invocations, before.stats.shader_invocations);
+    };
+    for (mr::DepthConvention convention : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
+        const mr::Camera cam = overlap_camera(convention, W, H);
+        for (std::size_t scene = 0; scene < std::size(last_states); ++scene) {
+            const glm::vec4 tint(0.5f, 0.7f, 0.2f, 0.6f);
+            std::vector<mr::Draw> draws = {make_draw(a, glm::dmat4(1.0), mr::DrawState{}),
+                                           make_draw(b, glm::dmat4(1.0), cut, glm::vec4(0.9f, 0.6f, 1.0f, 0.8f)),
+                                           make_draw(b, shifted, last_states[scene], tint)};
+            draws[0].texture = texture;
+            draws[1].texture = texture;
+            std::vector<mr::Draw> with_no_op = draws;
+            with_no_op.push_back(make_draw(off_screen, glm::dmat4(1.0), no_depth(mr::BlendMode::add)));
+            for (const auto& [aa, samples] : modes)
+                for (int variant = 0; variant < 4; ++variant)
+                    for (int threads : {1, 2}) {
+                        SCOPED_TRACE(mr::to_string(convention) + ", scene " + std::to_string(scene) + ", " +
+                                     mr::to_string(aa) + " " + std::to_string(samples) + ", variant " +
+                                     std::to_string(variant) + ", " + std::to_string(threads) + " threads");
+                        mr::RenderSettings s = settings(W, H, samples);
+                        s.anti_aliasing = aa;
+                        s.threads = threads;
+                        s.depth_output = true;
+                        s.clear_color = glm::vec4(0.25f, -0.0f, 1e-40f, 1.0f);
+                        s.deferred_shading = variant != 1;
+                        if (variant == 2) s.pixels = pixels;
+                        s.estimate_error = variant == 3 && samples > 1;
+                        const mr::RenderResult kept = mr::render(draws, cam, s);  // (settings keep the samples)
+                        s.keep_samples = false;
+                        const mr::RenderResult tiles = mr::render(draws, cam, s);
+                        same(tiles, kept, s.pixels.empty());
+                        if (scene == 0) {
+                            const mr::RenderResult cleared_before = mr::render(with_no_op, cam, s);
+                            same(tiles, cleared_before, true);
+                            EXPECT_EQ(cleared_before.stats.triangles_outside, tiles.stats.triangles_outside + 1);
+                        }
+                    }
+        }
+    }
+}
+
 TEST(Renderer, StatsJsonHoldsEveryCounter) {
     mr::RenderStats st;
     st.triangles_in = 7;

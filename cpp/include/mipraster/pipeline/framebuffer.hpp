@@ -46,6 +46,12 @@ struct SampleWindow {
     void fill(int x0, int y0, int x1, int y1, const glm::vec4& value) const;
 };
 
+/// The colour clear after drawing, for draws that write depth wherever they write colour: every
+/// sample of the pixels [x0, x1) × [y0, y1) whose depth is still `clear_depth` (none drew it) gets
+/// `value`. `color` and `depth` are windows with the same origin, pitch and samples.
+void fill_undrawn(const SampleWindow& color, const SampleWindow& depth, int x0, int y0, int x1, int y1,
+                  float clear_depth, const glm::vec4& value);
+
 /// Windows onto a whole framebuffer's colour and depth (depth.data is null when it has none).
 SampleWindow color_window(Framebuffer& framebuffer);
 SampleWindow depth_window(Framebuffer& framebuffer);
