@@ -199,6 +199,21 @@ def build_all_levels(state: Dict[str, Any]) -> None:
     texture.level(texture.level_count - 1)
 
 
+def with_no_op_draw(setup: Callable[[int, int], Dict[str, Any]]) -> Callable[[int, int], Dict[str, Any]]:
+    """`setup` plus one triangle off the screen drawn blending add without a depth test: nothing on
+    screen changes, but not every draw writes depth where it writes colour, so each tile's colour is
+    cleared before drawing again."""
+    def wrapped(width: int, height: int) -> Dict[str, Any]:
+        import mipraster as mr
+
+        state = setup(width, height)
+        triangle = np.array([[3.0, 0.0, 0.5], [4.0, 0.0, 0.5], [3.0, 1.0, 0.5]], np.float32)
+        state["scene"].add(mr.Mesh(triangle, np.array([[0, 1, 2]], np.uint32)), depth_test=False, depth_write=False,
+                           blend="add")
+        return state
+    return wrapped
+
+
 def with_options(setup: Callable[[int, int], Dict[str, Any]], **options: Any) -> Callable[[int, int], Dict[str, Any]]:
     """`setup` with extra mr.render options."""
     def wrapped(width: int, height: int) -> Dict[str, Any]:
@@ -226,6 +241,11 @@ OMISSIONS = [
              Variant("depth_test=False", colour_grid(depth_test=False)),
              Variant("depth_test=True (never rejects)", colour_grid()), "exact",
              "the depth buffer is tile-local (one per worker), so the memory it saves is small"),
+    Omission("no colour clear before drawing where every sample is drawn", "colour grid, MSAA 4x",
+             Variant("every draw tests and writes depth and replaces colour: the samples still at the clear "
+                     "depth are cleared after drawing", with_options(colour_grid(), spp=4, aa="msaa")),
+             Variant("+ one off-screen triangle blending add: each tile's colour cleared before drawing",
+                     with_options(with_no_op_draw(colour_grid()), spp=4, aa="msaa")), "exact"),
     Omission("lazily built mip levels", "full-screen quad magnifying a fresh 1024² texture",
              Variant("lazy: level 0 only", magnified_quad),
              Variant("every level built first (timed)", magnified_quad, build_all_levels), "exact"),
