@@ -179,6 +179,39 @@ def test_gltf_buffer_that_is_not_a_readable_file_is_an_error_naming_it(tmp_path,
     assert f"File not found : {uri}:" in str(e.value)
 
 
+@pytest.mark.parametrize("nodes, message", [
+    ([{"children": [1, 1]}, {"mesh": 0}], "node 1 is listed as a child twice by node 0"),
+    ([{"children": [2]}, {"children": [2]}, {"mesh": 0}], "node 2 is listed as a child by both node 0 and node 1"),
+    # each node twice the child of the one before: 2^40 paths to the mesh, a draw each (the load ran
+    # for minutes and allocated gigabytes before failing)
+    ([{"children": [i + 1, i + 1]} for i in range(40)] + [{"mesh": 0}], "node 1 is listed as a child twice by node 0"),
+])
+def test_gltf_node_with_more_than_one_parent_is_an_error_naming_it(tmp_path, nodes, message):
+    path = write_gltf(tmp_path / "dag.gltf")
+    doc = json.loads(path.read_text())
+    doc["nodes"], doc["scenes"] = nodes, [{"nodes": [0, 1] if "both" in message else [0]}]
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=rf"dag\.gltf: {message} \(a glTF node has at most one parent\)"):
+        mr.load_scene(path)
+
+
+@pytest.mark.parametrize("depth, message", [(1024, None), (1025, "lies more than 1024 levels below its root")])
+def test_gltf_node_chain_deeper_than_the_limit_is_named_as_such(tmp_path, depth, message):
+    # (the limit's error called the chain a cycle)
+    path = write_gltf(tmp_path / "chain.gltf")
+    doc = json.loads(path.read_text())
+    doc["nodes"] = [{"children": [i + 1]} for i in range(depth)] + [{"mesh": 0}]
+    doc["scenes"] = [{"nodes": [0]}]
+    path.write_text(json.dumps(doc))
+    if message is None:
+        scene, _ = mr.load_scene(path)
+        assert len(scene.draws) == 1
+        return
+    with pytest.raises(OSError, match=rf"chain\.gltf: node {depth} {message}") as e:
+        mr.load_scene(path)
+    assert "cycle" not in str(e.value)
+
+
 NEAREST_CLAMP = {"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33648}
 
 

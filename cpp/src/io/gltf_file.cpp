@@ -36,7 +36,7 @@ namespace scene_files {
 
 namespace {
 
-/// The node hierarchy is walked at most this deep (a deeper one is a cycle or hostile).
+/// The node hierarchy is walked at most this deep (the recursion's stack; a deeper file is hostile).
 constexpr int kMaxNodeDepth = 1024;
 static_assert(kMaxNodeDepth > 0, "limits must be positive");
 
@@ -358,6 +358,25 @@ struct UvChoice {
         return glm::vec2(c * scaled.x + s * scaled.y + offset.x, -s * scaled.x + c * scaled.y + offset.y);
     }
 };
+
+/// glTF's nodes form disjoint trees: a node is listed as a child at most once, by one parent. A
+/// node shared by two parents would be drawn once per path to it, twice as often with each level
+/// of sharing: a file of a kilobyte could ask for millions of draws.
+void check_single_parents(const tinygltf::Model& model, const std::string& path) {
+    std::vector<int> parent(model.nodes.size(), -1);
+    for (std::size_t p = 0; p < model.nodes.size(); ++p)
+        for (int child : model.nodes[p].children) {
+            if (child < 0 || static_cast<std::size_t>(child) >= model.nodes.size()) continue;  // (add_node names it)
+            const int first = parent[static_cast<std::size_t>(child)];
+            if (first >= 0)
+                fail(path, "node " + std::to_string(child) + " is listed as a child " +
+                               (static_cast<std::size_t>(first) == p
+                                    ? "twice by node " + std::to_string(p)
+                                    : "by both node " + std::to_string(first) + " and node " + std::to_string(p)) +
+                               " (a glTF node has at most one parent)");
+            parent[static_cast<std::size_t>(child)] = static_cast<int>(p);
+        }
+}
 
 struct GltfLoader {
     const tinygltf::Model& model;
@@ -810,8 +829,11 @@ struct GltfLoader {
         if (index < 0 || static_cast<std::size_t>(index) >= model.nodes.size())
             fail(path, "node " + std::to_string(index) + " does not exist (the file has " +
                            std::to_string(model.nodes.size()) + " nodes)");
-        if (on_path[index] || depth > kMaxNodeDepth)
+        if (on_path[index])
             fail(path, "node " + std::to_string(index) + " is its own ancestor (a cycle in the node hierarchy)");
+        if (depth > kMaxNodeDepth)
+            fail(path, "node " + std::to_string(index) + " lies more than " + std::to_string(kMaxNodeDepth) +
+                           " levels below its root, deeper than this loader follows the node hierarchy");
         on_path[index] = true;
         const tinygltf::Node& node = model.nodes[index];
         const glm::dmat4 world = parent * node_matrix(node, path, index);
@@ -1089,6 +1111,7 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
     check_required_extensions(model, path);
     if (!ok) fail(path, "cannot read glTF: " + trim(err.empty() ? warn : err));
 
+    check_single_parents(model, path);
     GltfLoader g(model, path, embedded);
     // tinygltf's notes about external image files it could not read are dropped: images are
     // loaded (or warned about, naming the material) by image_texture.
