@@ -1,4 +1,6 @@
 """Image files and sRGB: RenderResult.save, read_image / write_image, to_srgb8, and their errors."""
+import os
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -162,6 +164,18 @@ def test_missing_file_raises_file_not_found(tmp_path):
     with pytest.raises(FileNotFoundError) as e:
         mr.read_image(missing)
     assert e.value.filename == str(missing)
+
+
+@pytest.mark.parametrize("kind", ["device", "fifo", "directory"])
+def test_a_path_that_is_not_a_regular_file_raises_os_error_naming_it(tmp_path, kind):
+    # /dev/zero: OpenImageIO's readers searched its endless bytes for a header and never returned;
+    # a FIFO without a writer blocked the open.
+    path = {"device": "/dev/zero", "fifo": tmp_path / "pipe.png", "directory": tmp_path}[kind]
+    if kind == "fifo":
+        os.mkfifo(path)
+    with pytest.raises(OSError, match="not a regular file") as e:
+        mr.read_image(path)
+    assert str(path) in str(e.value) and e.value.filename == str(path)
 
 
 def test_corrupt_file_raises_os_error_naming_it(tmp_path):

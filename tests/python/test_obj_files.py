@@ -386,6 +386,15 @@ def test_bad_face_indices_are_errors_naming_file_and_line(tmp_path, text, messag
         mr.load_scene(path)
 
 
+def test_map_kd_naming_a_device_warns_and_draws_the_error_texture(tmp_path):
+    # /dev/zero as a texture: OpenImageIO searched its endless bytes for a header and never returned.
+    (tmp_path / "m.mtl").write_text("newmtl tex\nmap_Kd /dev/zero\n")
+    (tmp_path / "s.obj").write_text(obj_text())
+    scene, messages = load_quiet(tmp_path / "s.obj")
+    assert scene.draws[0].texture.name == "error texture"
+    assert any("'/dev/zero'" in m and "not a regular file" in m for m in messages), messages
+
+
 # --- polygons --------------------------------------------------------------------------------
 
 

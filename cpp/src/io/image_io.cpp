@@ -287,6 +287,14 @@ std::string sniff_extension(const unsigned char* b, std::size_t size) {
 Image read_image(const std::string& path) { return read_image(path, ImageReadOptions{}); }
 
 Image read_image(const std::string& path, const ImageReadOptions& options) {
+    // A regular file only: on a device or a pipe (/dev/zero, a FIFO) OpenImageIO's readers searched
+    // the endless bytes for a header and never returned, and opening a FIFO waits for a writer.
+    std::error_code ec;
+    const std::filesystem::file_status status = std::filesystem::status(path, ec);
+    if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+        throw std::runtime_error("read_image: cannot read '" + path + "': not a regular file (" +
+                                 (std::filesystem::is_directory(status) ? "a directory" : "a device, pipe or socket") +
+                                 ")");
     // Open, asking for the file's own (straight) alpha so that we premultiply in linear space.
     unsigned char header[10];
     std::size_t got = 0;
