@@ -25,6 +25,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -344,6 +345,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
             if (comma != std::string::npos) o.wrap.push_back(parse_wrap_mode(v.substr(comma + 1)));
         } else if (a == "--lod-bias") {
             o.lod_bias = parse_number(a, value());
+            if (std::fabs(o.lod_bias) > std::numeric_limits<float>::max())  // (the sampler's bias is a float)
+                throw UsageError("--lod-bias: " + args[i] + " is beyond float's range");
             o.has_lod_bias = true;
         } else if (a == "--debug-view") {
             o.settings.debug_view = parse_debug_view(value());

@@ -6,7 +6,6 @@ number or a value out of range. Messages name the argument, what was expected an
 """
 from __future__ import annotations
 
-import math
 import operator
 from typing import Any, Mapping, Optional, Sequence, Tuple, TypeVar
 
@@ -100,13 +99,16 @@ def check_finite(a: np.ndarray, name: str) -> None:
     raise ValueError(f"{where} is {a[index]}; expected a finite number")
 
 
+FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
 def check_fits_float32(a: np.ndarray, name: str) -> None:
     """ValueError naming the first finite element beyond float32's range (NaN and ±inf are left to
     the caller): converted to float32 it would become ±inf."""
     if a.dtype.kind != "f" or a.dtype.itemsize <= 4:
         return
     with np.errstate(invalid="ignore"):
-        big = np.isfinite(a) & (np.abs(a) > float(np.finfo(np.float32).max))
+        big = np.isfinite(a) & (np.abs(a) > FLOAT32_MAX)
     if big.any():
         index = tuple(int(i) for i in np.argwhere(big)[0])
         raise ValueError(f"{name}[{', '.join(map(str, index))}] = {a[index]} does not fit in float32")
@@ -141,10 +143,12 @@ def matrix(value: Any, name: str, rows: int, columns: int) -> np.ndarray:
 
 
 def rgba(value: Any, name: str) -> Tuple[float, float, float, float]:
-    """A colour of 3 (alpha 1) or 4 finite components."""
-    if type(value) in (tuple, list) and len(value) in (3, 4) and all(type(c) is float and math.isfinite(c) for c in value):
+    """A colour of 3 (alpha 1) or 4 finite components that fit in float32 (the renderer's colours)."""
+    if type(value) in (tuple, list) and len(value) in (3, 4) and all(
+            type(c) is float and abs(c) <= FLOAT32_MAX for c in value):  # (NaN fails the comparison)
         return (value[0], value[1], value[2], value[3] if len(value) == 4 else 1.0)  # (a render's common case, fast)
     a = vector(value, name, (3, 4))
+    check_fits_float32(a, name)
     if a.shape[0] == 3:
         a = np.append(a, 1.0)
     return (float(a[0]), float(a[1]), float(a[2]), float(a[3]))

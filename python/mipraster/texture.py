@@ -36,7 +36,6 @@ WRAP_MODES = {
     "border": _core.WrapMode.border,
 }
 
-_FLOAT32_MAX = float(np.finfo(np.float32).max)
 _SIZE_MAX = 2**64 - 1
 
 
@@ -45,7 +44,7 @@ def _float32(value: Any, name: str) -> float:
     v = _checks.real(value, name)
     if not math.isfinite(v):
         raise ValueError(f"{name}: expected a finite number, got {v!r}")
-    if abs(v) > _FLOAT32_MAX:
+    if abs(v) > _checks.FLOAT32_MAX:
         raise ValueError(f"{name}: {v!r} does not fit in float32")
     return v
 
@@ -126,9 +125,6 @@ class Sampler:
             raise ValueError(f"max_anisotropy: expected a number >= 1, got {max_anisotropy!r}")
         wrap = _wrap_modes(self.wrap)
         border = _checks.rgba(self.border_color, "border_color")
-        for c, value in enumerate(border):
-            if abs(value) > _FLOAT32_MAX:
-                raise ValueError(f"border_color[{c}] = {value!r} does not fit in float32")
         lod_bias = _float32(self.lod_bias, "lod_bias")
         min_lod = _float32(self.min_lod, "min_lod")
         max_lod = _float32(self.max_lod, "max_lod")

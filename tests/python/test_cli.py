@@ -106,6 +106,7 @@ def test_exr_output_is_openexr(tmp_path):
         (["--debug-view", "lod"], ["lod", "mip-level"]),
         (["--derivatives", "numeric"], ["numeric", "quad"]),
         (["--lod-bias", "x"], ["--lod-bias"]),
+        (["--lod-bias", "-1e300"], ["--lod-bias", "-1e300", "beyond float's range"]),  # (was called "not finite")
         (["--seed", "-1"], ["--seed", "from 0 to 18446744073709551615", "'-1'"]),  # (was taken as 2^64 - 1)
         (["--seed", "18446744073709551616"], ["--seed", "'18446744073709551616'"]),
         (["--bits", "12"], ["--bits", "8 or 16", "'12'"]),

@@ -386,6 +386,19 @@ def test_bad_face_indices_are_errors_naming_file_and_line(tmp_path, text, messag
         mr.load_scene(path)
 
 
+@pytest.mark.parametrize("kd", ["1e39 0 0", "0.5", "0 0 -4e38"])
+def test_kd_beyond_float_is_an_error_naming_the_mtl_line(tmp_path, kd):
+    # (finite as a double, inf as the draw's float colour: the render refused "draws[0].color")
+    (tmp_path / "m.mtl").write_text(f"newmtl tex\nKd {kd}\n")
+    (tmp_path / "s.obj").write_text(obj_text())
+    if kd == "0.5":
+        scene, _ = mr.load_scene(tmp_path / "s.obj")
+        assert scene.draws[0].color == (0.5, 0.5, 0.5, 1)
+        return
+    with pytest.raises(OSError, match=rf"m\.mtl: line 2 \('Kd {kd}'\): Kd's numbers are beyond float's range"):
+        mr.load_scene(tmp_path / "s.obj")
+
+
 def test_map_kd_naming_a_device_warns_and_draws_the_error_texture(tmp_path):
     # /dev/zero as a texture: OpenImageIO searched its endless bytes for a header and never returned.
     (tmp_path / "m.mtl").write_text("newmtl tex\nmap_Kd /dev/zero\n")

@@ -240,6 +240,7 @@ def one_draw_scene():
         (dict(model=np.diag([1, 1, np.nan, 1])), ["model[2, 2]", "nan"]),
         (dict(color=(1, 1)), ["color", "(3,) or (4,)", "(2,)"]),
         (dict(color=(1, np.inf, 1)), ["color[1]", "inf"]),
+        (dict(color=(1.0, 1.0, 1e39)), ["color[2] = 1e+39", "does not fit in float32"]),
     ],
 )
 def test_scene_add_refuses_bad_values(kwargs, words):
@@ -289,6 +290,9 @@ def test_scene_add_refuses_wrong_types(kwargs, words):
         (dict(clear_color=(0.0, float("nan"), 0.0)), "clear_color[1] is nan; expected a finite number"),
         (dict(clear_color=[0.0, 0.0, 0.0, float("inf")]), "clear_color[3] is inf; expected a finite number"),
         (dict(clear_color=[0.0] * 5), "clear_color: expected shape (3,) or (4,), got (5,)"),
+        # finite as a double, infinite as the float32 the framebuffer holds (the fast path and numpy's)
+        (dict(clear_color=(1e39, 0.0, 0.0, 1.0)), "clear_color[0] = 1e+39 does not fit in float32"),
+        (dict(clear_color=np.array([0.0, 0.0, -3.5e38])), "clear_color[2] = -3.5e+38 does not fit in float32"),
     ],
 )
 def test_render_refuses_bad_settings_with_value_error(kwargs, message):

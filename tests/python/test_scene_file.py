@@ -212,6 +212,19 @@ def test_gltf_node_chain_deeper_than_the_limit_is_named_as_such(tmp_path, depth,
     assert "cycle" not in str(e.value)
 
 
+@pytest.mark.parametrize("factor", [[1e39, 0, 0, 1], [1e30, 1, 1, 1e30]])
+def test_gltf_base_color_beyond_float_is_an_error_naming_the_material(tmp_path, factor):
+    # a component past float's range, or (BLEND) a colour times alpha past it
+    path = write_gltf(tmp_path / "big.gltf")
+    doc = json.loads(path.read_text())
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = factor
+    if factor[3] != 1:
+        doc["materials"][0]["alphaMode"] = "BLEND"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=r"big\.gltf: material .*: baseColorFactor is beyond float's range"):
+        mr.load_scene(path)
+
+
 NEAREST_CLAMP = {"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33648}
 
 

@@ -434,6 +434,9 @@ struct GltfLoader {
         } else {
             draw.color = glm::vec4(f[0], f[1], f[2], 1.0);
         }
+        for (int c = 0; c < 4; ++c)  // (finite doubles beyond float's range, or their products)
+            if (!std::isfinite(draw.color[c]))
+                fail(path, name + ": baseColorFactor is beyond float's range (the colour overflows to infinity)");
         if (mask) {
             const double cutoff = mat.alphaCutoff;
             if (cutoff >= 0.0 && cutoff <= 1.0) {

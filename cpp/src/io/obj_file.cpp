@@ -574,6 +574,8 @@ void read_mtl(const std::string& path, std::vector<ObjMaterial>& materials, std:
             }
             const std::vector<double> v = numbers(3);
             if (v.size() == 2) bad("Kd takes 1 or 3 numbers");
+            for (double x : v)  // (the draw's colour is float: 1e39 would become inf)
+                if (std::fabs(x) > std::numeric_limits<float>::max()) bad("Kd's numbers are beyond float's range");
             m->kd = glm::vec3(static_cast<float>(v[0]));
             if (v.size() == 3) m->kd = glm::vec3(glm::dvec3(v[0], v[1], v[2]));
         } else if (keyword == "d" || keyword == "Tr") {
