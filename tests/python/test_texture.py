@@ -229,10 +229,18 @@ def test_float64_beyond_float32():
         mr.Texture(np.array([[0.0, 1e300]]))
 
 
-def test_premultiplying_into_overflow_is_refused_by_the_core():
-    # both finite, but 3e38 × 2 is not: the C++ check names the texel
-    with pytest.raises(ValueError, match=r"texture 'big': texel \(0, 0\) channel 0 is not finite"):
-        mr.Texture(np.array([[[3e38, 0, 0, 2]]], np.float32), name="big")
+@pytest.mark.parametrize("texel, message", [
+    # each value finite and within range, the colour times alpha past ±1e32 or float's range
+    ((1e20, 1e20, 1e20, 1e20),
+     r"channel 0 is 1e\+20, times its alpha 1e\+20 beyond ±1e\+32 \(texels are premultiplied\)"),
+    ((0, -1e17, 0, 1e16), r"channel 1 is -1e\+17, times its alpha 1e\+16 beyond ±1e\+32"),
+    # a value itself past the range: named as given, not as its product with alpha
+    ((3e38, 0, 0, 2), r"channel 0 is 3e\+38; texel values must lie within ±1e\+32"),
+])
+def test_premultiplying_into_overflow_is_refused_by_the_core(texel, message):
+    # (the C++ check saw only the products, and called an overflowed one "not finite")
+    with pytest.raises(ValueError, match=r"texture 'big': texel \(0, 0\) " + message):
+        mr.Texture(np.array([[texel]], np.float32), name="big")
 
 
 def test_texels_beyond_the_filters_range_are_refused():

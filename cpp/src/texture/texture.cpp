@@ -109,6 +109,22 @@ std::uint64_t tick() {
     return ++clock;
 }
 
+// The error for channel c of texel i (row-major, `width` a row) of texture `name`: its value v is
+// not finite or beyond ±kMaxTexelMagnitude, or (given its alpha) v × alpha is.
+[[noreturn]] void bad_texel(const std::string& name, int width, std::size_t i, int c, float v,
+                            const float* alpha = nullptr) {
+    char what[160] = " is not finite";
+    if (std::isfinite(v) && std::fabs(v) > kMaxTexelMagnitude)
+        std::snprintf(what, sizeof what,
+                      " is %g; texel values must lie within ±%g so that the filters' sums stay finite", double(v),
+                      double(kMaxTexelMagnitude));
+    else if (alpha)
+        std::snprintf(what, sizeof what, " is %g, times its alpha %g beyond ±%g (texels are premultiplied)", double(v),
+                      double(*alpha), double(kMaxTexelMagnitude));
+    throw std::invalid_argument("texture '" + name + "': texel (" + std::to_string(i % width) + ", " +
+                                std::to_string(i / width) + ") channel " + std::to_string(c) + what);
+}
+
 }  // namespace
 
 // ---- Texture -----------------------------------------------------------------------------------
@@ -120,17 +136,9 @@ Texture::Texture(TextureLevel level0, std::string name) {
                                     " texels for a " + std::to_string(level0.width) + "x" +
                                     std::to_string(level0.height) + " level");
     for (std::size_t i = 0; i < level0.texels.size(); ++i)
-        for (int c = 0; c < 4; ++c) {
-            const float v = level0.texels[i][c];
-            if (std::fabs(v) <= kMaxTexelMagnitude) continue;
-            char what[128] = " is not finite";
-            if (std::isfinite(v))
-                std::snprintf(what, sizeof what,
-                              " is %g; texel values must lie within ±%g so that the filters' sums stay finite",
-                              double(v), double(kMaxTexelMagnitude));
-            throw std::invalid_argument("texture '" + name + "': texel (" + std::to_string(i % level0.width) + ", " +
-                                        std::to_string(i / level0.width) + ") channel " + std::to_string(c) + what);
-        }
+        for (int c = 0; c < 4; ++c)
+            if (!(std::fabs(level0.texels[i][c]) <= kMaxTexelMagnitude))
+                bad_texel(name, level0.width, i, c, level0.texels[i][c]);
     data_ = std::make_shared<TextureData>();
     data_->level_count = mip_level_count(level0.width, level0.height);
     data_->base = std::move(level0);
@@ -161,6 +169,19 @@ Texture Texture::from_16bit(const std::uint16_t* texels, int width, int height, 
 Texture Texture::from_float(const float* texels, int width, int height, int channels, bool premultiplied,
                             std::string name) {
     check_size(width, height, channels, name);
+    if (!premultiplied && channels % 2 == 0) {
+        // The values as given, then their products with alpha: the constructor sees only the
+        // products, and called one that overflowed "not finite" though every value given is finite.
+        for (std::size_t p = 0; p < static_cast<std::size_t>(width) * static_cast<std::size_t>(height); ++p) {
+            const float* const t = texels + p * static_cast<std::size_t>(channels);
+            for (int c = 0; c < channels; ++c)  // (the last is alpha: channel 3 of the texture)
+                if (!(std::fabs(t[c]) <= kMaxTexelMagnitude))
+                    bad_texel(name, width, p, c == channels - 1 ? 3 : c, t[c]);
+            for (int c = 0; c + 1 < channels; ++c)
+                if (!(std::fabs(t[c] * t[channels - 1]) <= kMaxTexelMagnitude))
+                    bad_texel(name, width, p, c, t[c], &t[channels - 1]);
+        }
+    }
     auto value = [&](std::size_t i) { return texels[i]; };
     return Texture(expand(width, height, channels, !premultiplied, value, value), std::move(name));
 }
