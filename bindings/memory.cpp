@@ -28,9 +28,16 @@ void bind_memory(py::module_& m) {
     m.def("memory_limit", &memory_limit, "The process-wide memory limit in bytes.");
     m.def(
         "set_memory_limit",
-        [](long long bytes) {
-            if (bytes < 0) throw py::value_error("memory limit: expected bytes >= 0 (0 = the default), got " + std::to_string(bytes));
-            set_memory_limit(static_cast<std::uint64_t>(bytes));
+        [](const py::int_& bytes) {  // (any Python int: one beyond 64 bits failed as "incompatible arguments")
+            const std::string text = py::str(bytes);
+            if (PyBool_Check(bytes.ptr())) throw py::type_error("memory limit: expected an integer, got bool " + text);
+            if (text[0] == '-') throw py::value_error("memory limit: expected bytes >= 0 (0 = the default), got " + text);
+            const unsigned long long value = PyLong_AsUnsignedLongLong(bytes.ptr());
+            if (PyErr_Occurred()) {
+                PyErr_Clear();
+                throw py::value_error("memory limit: " + text + " bytes is beyond 2^64 - 1");
+            }
+            set_memory_limit(static_cast<std::uint64_t>(value));
         },
         py::arg("bytes"), "Sets the process-wide memory limit in bytes; 0 restores the default.");
     m.attr("DEFAULT_MEMORY_LIMIT") = kDefaultMemoryLimit;

@@ -37,6 +37,12 @@ def test_default_and_restore(limit):
     assert mr.memory_limit() == 16 << 30
     with pytest.raises(ValueError, match="memory limit: expected bytes >= 0"):
         mr.set_memory_limit(-1)
+    with pytest.raises(ValueError, match=r"memory limit: 1180591620717411303424 bytes is beyond 2\^64 - 1"):
+        mr.set_memory_limit(2**70)  # (was pybind11's "incompatible function arguments")
+    with pytest.raises(TypeError, match="memory limit: expected an integer, got bool True"):
+        mr.set_memory_limit(True)
+    limit(2**64 - 1)
+    assert mr.memory_limit() == 2**64 - 1
 
 
 def test_render_refused_with_estimate_and_limit(limit):

@@ -178,3 +178,15 @@ def test_bad_input_is_refused_with_a_message_naming_it():
         mr.render(mr.Scene(), mr.Camera.from_matrices(np.eye(4), np.eye(4)), 4, 4, resolve_filter="gauss")
     with pytest.raises(ValueError, match="MiB"):  # refused before allocating
         _core.resample(a, 60000, 60000, "box")
+
+
+def test_resampling_past_the_memory_limit_is_refused_before_allocating():
+    # (only the fixed 8 GiB cap was checked: under a 64 MiB limit, 4096² RGB took 200 MB)
+    a = random_image(4, 4, 3, 6)
+    mr.set_memory_limit(64 << 20)
+    try:
+        with pytest.raises(mr.MemoryLimitError, match="resampling to 4096x4096"):
+            mr.resample(a, (4096, 4096))
+        assert mr.resample(a, (512, 512)).shape == (512, 512, 3)  # 6 MiB: under the limit
+    finally:
+        mr.set_memory_limit(0)

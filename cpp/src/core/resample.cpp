@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <stdexcept>
 
+#include "mipraster/core/memory_limit.hpp"
 #include "mipraster/core/thread_pool.hpp"
 
 namespace mipraster {
@@ -102,6 +103,8 @@ Image resample(const Image& image, int width, int height, ReconstructionFilter f
                                     std::to_string(std::max(out_bytes, mid_bytes) >> 20) + " MiB; the limit is " +
                                     std::to_string(kMaxResampleBytes >> 20) + " MiB");
     if (width == image.width && height == image.height) return image;
+    // (The cap above is fixed; the process's memory limit can be lower.)
+    check_memory(out_bytes + mid_bytes, "resampling to " + std::to_string(width) + "x" + std::to_string(height));
 
     const ResampleWeights wx = resample_weights(image.width, width, filter);
     const ResampleWeights wy = resample_weights(image.height, height, filter);
