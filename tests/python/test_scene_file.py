@@ -944,3 +944,86 @@ def test_gltf_mesh_quantization_texcoords(tmp_path):
         np.testing.assert_allclose(scene.draws[0].mesh.uvs, np.float32(values).reshape(4, 2) / scale,
                                    err_msg=str((component, normalized)))
         assert scene.draws[0].texture is not None
+
+
+# --- morph targets and skins (their rest pose: the nodes' own transforms, no animation) ----------
+
+TRIANGLE = np.float32([[-0.5, -0.5, 0], [0.5, -0.5, 0], [0, 0.5, 0]])
+
+
+def test_gltf_morph_targets_at_the_node_or_mesh_default_weights(tmp_path):
+    # Positions = base + Σ weight_t · target_t (the spec's morphing), per node: the mesh's default
+    # weights (0.25, 0.5), a node's own (1, 0) and all zero (the base shape).
+    rng = np.random.default_rng(44)
+    targets = rng.uniform(-0.3, 0.3, (2, 3, 3)).astype(np.float32)
+    chunks = [TRIANGLE.tobytes(), targets[0].tobytes(), targets[1].tobytes()]
+    accessors = [vec_accessor(0, 3, min=[-0.5, -0.5, 0], max=[0.5, 0.5, 0]), vec_accessor(1, 3), vec_accessor(2, 3)]
+    primitive = {"attributes": {"POSITION": 0}, "targets": [{"POSITION": 1}, {"POSITION": 2}]}
+    meshes = [{"primitives": [primitive], "weights": [0.25, 0.5]}]
+    nodes = [{"mesh": 0}, {"mesh": 0, "weights": [1.0, 0.0]}, {"mesh": 0, "weights": [0.0, 0.0]}]
+    scene, _ = mr.load_scene(write_mesh_gltf(tmp_path / "morph.gltf", chunks, accessors, None, meshes=meshes,
+                                             nodes=nodes))
+    base = TRIANGLE.astype(np.float64)
+    for draw, w in zip(scene.draws, [(0.25, 0.5), (1.0, 0.0), (0.0, 0.0)]):
+        want = base + w[0] * targets[0].astype(np.float64) + w[1] * targets[1].astype(np.float64)
+        np.testing.assert_allclose(draw.mesh.positions, want.astype(np.float32), rtol=0, atol=1e-7, err_msg=str(w))
+    bad = write_mesh_gltf(tmp_path / "bad.gltf", chunks, accessors, None, meshes=meshes,
+                          nodes=[{"mesh": 0, "weights": [1.0]}])
+    with pytest.raises(OSError, match=r"bad\.gltf: node 0: its weights has 1 entries for 2 morph targets"):
+        mr.load_scene(bad)
+
+
+def trs(translation=(0, 0, 0), rotation=(0, 0, 0, 1), scale=(1, 1, 1)):
+    """glTF's T · R · S of a node (rotation a unit quaternion x, y, z, w), as numpy does it."""
+    x, y, z, w = rotation
+    r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                  [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                  [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    m = np.eye(4)
+    m[:3, :3] = r * np.asarray(scale, float)
+    m[:3, 3] = translation
+    return m
+
+
+def test_gltf_skin_places_vertices_by_their_joints_at_rest(tmp_path):
+    # Linear blend skinning at the joints' own transforms: v' = Σ w_j · (global_j · inverseBind_j) · v,
+    # the skinned node's own transform ignored (the spec). Joint 1 is joint 0's child; weights
+    # spread one vertex over both joints and sit in two sets (JOINTS_1 / WEIGHTS_1).
+    half = np.sqrt(0.5)
+    joint0 = {"translation": [0.1, 0.2, 0.0], "rotation": [0, 0, half, half], "children": [2]}
+    joint1 = {"translation": [0.0, 0.3, 0.0], "scale": [0.5, 0.5, 0.5]}
+    inverse_bind = [np.linalg.inv(trs((0.05, 0, 0))), np.linalg.inv(trs((0, 0.1, 0), scale=(2, 2, 2)))]
+    joints = np.uint8([[0, 1, 0, 0], [0, 1, 0, 0], [1, 0, 0, 0]])
+    weights = np.float32([[1, 0, 0, 0], [0.25, 0.5, 0, 0], [0.5, 0, 0, 0]])
+    joints1 = np.uint8([[0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0]])
+    weights1 = np.float32([[0, 0, 0, 0], [0.25, 0, 0, 0], [0.5, 0, 0, 0]])
+    ibm = np.float32([m.T for m in inverse_bind])  # column-major MAT4s
+    chunks = [TRIANGLE.tobytes(), joints.tobytes(), weights.tobytes(), joints1.tobytes(), weights1.tobytes(),
+              ibm.tobytes()]
+    accessors = [vec_accessor(0, 3, min=[-0.5, -0.5, 0], max=[0.5, 0.5, 0]), vec_accessor(1, 3, "VEC4", 5121),
+                 vec_accessor(2, 3, "VEC4"), vec_accessor(3, 3, "VEC4", 5121), vec_accessor(4, 3, "VEC4"),
+                 vec_accessor(5, 2, "MAT4")]
+    primitive = {"attributes": {"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2, "JOINTS_1": 3, "WEIGHTS_1": 4}}
+    nodes = [{"mesh": 0, "skin": 0, "translation": [100, 0, 0]}, joint0, joint1]
+    path = write_mesh_gltf(tmp_path / "skin.gltf", [*chunks], accessors, [primitive], nodes=nodes,
+                           extra={"skins": [{"joints": [1, 2], "inverseBindMatrices": 5}]})
+    doc = json.loads(path.read_text())
+    doc["scenes"] = [{"nodes": [0, 1, 3]}]  # (joint 1 is only joint 0's child)
+    path.write_text(json.dumps(doc))
+    scene, _ = mr.load_scene(path)
+
+    global0 = trs((0.1, 0.2, 0), (0, 0, half, half))
+    global1 = global0 @ trs((0, 0.3, 0), scale=(0.5, 0.5, 0.5))
+    skinning = [global0 @ inverse_bind[0], global1 @ inverse_bind[1]]
+    want = []
+    for v, js, ws in zip(TRIANGLE, np.hstack([joints, joints1]), np.hstack([weights, weights1])):
+        m = sum(float(w) * skinning[j] for j, w in zip(js, ws))
+        want.append((m @ np.append(v.astype(np.float64), 1.0))[:3])
+    (draw,) = scene.draws
+    np.testing.assert_allclose(draw.model, np.eye(4))
+    np.testing.assert_allclose(draw.mesh.positions, np.float32(want), rtol=0, atol=1e-6)
+
+    doc["skins"][0]["joints"] = [1, 7]
+    path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=r"skin\.gltf: skins\[0\]: joint 1 is node 7, which does not exist"):
+        mr.load_scene(path)

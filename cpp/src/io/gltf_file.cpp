@@ -21,6 +21,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -124,7 +125,7 @@ public:
         component_type_ = a.componentType;
         size_ = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(a.componentType));
         normalized_ = a.normalized;
-        if (components_ <= 0 || components_ > 4 || size_ <= 0)
+        if (components_ <= 0 || components_ > 16 || size_ <= 0)
             fail(path, what_ + ": unsupported type " + std::to_string(a.type) + " / component type " +
                            std::to_string(a.componentType));
         if (count_ > kMaxElements) fail(path, what_ + ": absurd count " + std::to_string(count_));
@@ -359,10 +360,10 @@ struct UvChoice {
     }
 };
 
-/// glTF's nodes form disjoint trees: a node is listed as a child at most once, by one parent. A
-/// node shared by two parents would be drawn once per path to it, twice as often with each level
-/// of sharing: a file of a kilobyte could ask for millions of draws.
-void check_single_parents(const tinygltf::Model& model, const std::string& path) {
+/// Each node's parent (−1: none). glTF's nodes form disjoint trees: a node is listed as a child at
+/// most once, by one parent. A node shared by two parents would be drawn once per path to it, twice
+/// as often with each level of sharing: a file of a kilobyte could ask for millions of draws.
+std::vector<int> node_parents(const tinygltf::Model& model, const std::string& path) {
     std::vector<int> parent(model.nodes.size(), -1);
     for (std::size_t p = 0; p < model.nodes.size(); ++p)
         for (int child : model.nodes[p].children) {
@@ -376,6 +377,7 @@ void check_single_parents(const tinygltf::Model& model, const std::string& path)
                                " (a glTF node has at most one parent)");
             parent[static_cast<std::size_t>(child)] = static_cast<int>(p);
         }
+    return parent;
 }
 
 struct GltfLoader {
@@ -383,15 +385,18 @@ struct GltfLoader {
     const std::string& path;
     const EmbeddedImages& embedded;
     LoadedScene scene;
-    std::map<std::pair<int, int>, std::shared_ptr<Mesh>> mesh_cache;  // (mesh, primitive) → mesh
+    // (mesh, primitive, morph weights, skinned node or −1) → mesh
+    std::map<std::tuple<int, int, std::vector<double>, int>, std::shared_ptr<Mesh>> mesh_cache;
     std::map<std::pair<int, bool>, Texture> texture_cache;            // (image, ignore alpha) → texture
     std::set<std::string> warned;                                     // warnings given once
     std::size_t skipped_primitives = 0;
     std::vector<bool> on_path;  // nodes on the current root-to-node path (cycle detection)
+    std::vector<int> parents;   // node_parents
+    std::map<int, glm::dmat4> globals;  // global_matrix's, by node
     bool quantized = false;     // the file uses KHR_mesh_quantization (integer texture coordinates)
 
-    GltfLoader(const tinygltf::Model& m, const std::string& p, const EmbeddedImages& e)
-        : model(m), path(p), embedded(e), on_path(m.nodes.size(), false) {
+    GltfLoader(const tinygltf::Model& m, const std::string& p, const EmbeddedImages& e, std::vector<int> parent)
+        : model(m), path(p), embedded(e), on_path(m.nodes.size(), false), parents(std::move(parent)) {
         const auto lists = [&](const std::vector<std::string>& names) {
             return std::find(names.begin(), names.end(), "KHR_mesh_quantization") != names.end();
         };
@@ -737,8 +742,127 @@ struct GltfLoader {
                (small_unsigned || type == TINYGLTF_COMPONENT_TYPE_BYTE || type == TINYGLTF_COMPONENT_TYPE_SHORT);
     }
 
-    std::shared_ptr<Mesh> primitive_mesh(int mesh_index, int prim_index) {
-        const auto key = std::make_pair(mesh_index, prim_index);
+    /// The morph target weights a node's mesh is drawn at: the node's, else the mesh's defaults
+    /// (none: the base shape); empty when all are zero, so that such nodes share one mesh.
+    std::vector<double> morph_weights(const tinygltf::Node& node, int index, const tinygltf::Mesh& m) {
+        const std::vector<double>& w = node.weights.empty() ? m.weights : node.weights;
+        std::size_t targets = 0;
+        for (const tinygltf::Primitive& prim : m.primitives) targets = std::max(targets, prim.targets.size());
+        const std::string whose = node.weights.empty() ? "its mesh's weights" : "its weights";
+        if (!w.empty() && w.size() != targets)
+            fail(path, "node " + std::to_string(index) + ": " + whose + " has " + std::to_string(w.size()) +
+                           " entries for " + std::to_string(targets) + " morph targets");
+        for (double x : w)
+            if (!std::isfinite(x)) fail(path, "node " + std::to_string(index) + ": " + whose + " are not finite");
+        return std::all_of(w.begin(), w.end(), [](double x) { return x == 0.0; }) ? std::vector<double>{} : w;
+    }
+
+    /// Adds each morph target's POSITION displacements times its weight (normals and tangents,
+    /// the other standard targets, do not change an unlit render).
+    void morph(const tinygltf::Primitive& prim, const std::vector<double>& weights, std::vector<glm::dvec3>& positions,
+               const std::string& what) {
+        for (std::size_t t = 0; t < weights.size() && t < prim.targets.size(); ++t) {
+            const auto it = prim.targets[t].find("POSITION");
+            if (weights[t] == 0.0 || it == prim.targets[t].end()) continue;
+            const AccessorReader d(model, it->second, path, what + " targets[" + std::to_string(t) + "] POSITION");
+            if (d.components() != 3) fail(path, d.what() + ": POSITION must be VEC3");
+            if (d.count() != positions.size())
+                fail(path, d.what() + ": has " + std::to_string(d.count()) + " elements, POSITION " +
+                               std::to_string(positions.size()));
+            for (std::size_t i = 0; i < positions.size(); ++i)
+                positions[i] += weights[t] * glm::dvec3(d.get(i, 0), d.get(i, 1), d.get(i, 2));
+        }
+    }
+
+    /// A node's matrix in the scene: its ancestors' matrices times its own (nodes have one parent).
+    glm::dmat4 global_matrix(int node) {
+        std::vector<int> chain;  // node, its parent, … up to a root or a node already known
+        int n = node;
+        for (; n >= 0 && !globals.count(n); n = parents[static_cast<std::size_t>(n)]) {
+            if (chain.size() > static_cast<std::size_t>(kMaxNodeDepth))
+                fail(path, "node " + std::to_string(node) + ": its ancestors form a cycle or lie more than " +
+                               std::to_string(kMaxNodeDepth) + " levels deep");
+            chain.push_back(n);
+        }
+        glm::dmat4 m = n >= 0 ? globals[n] : glm::dmat4(1.0);
+        for (auto c = chain.rbegin(); c != chain.rend(); ++c)
+            globals[*c] = m = m * node_matrix(model.nodes[static_cast<std::size_t>(*c)], path, *c);
+        return m;
+    }
+
+    /// Skin k's joint matrices at the nodes' own transforms (the rest pose; animations are not
+    /// played): each joint's global matrix times its inverse bind matrix.
+    std::vector<glm::dmat4> joint_matrices(int k) {
+        if (k < 0 || static_cast<std::size_t>(k) >= model.skins.size())
+            fail(path, "skin " + std::to_string(k) + " does not exist (the file has " +
+                           std::to_string(model.skins.size()) + ")");
+        const tinygltf::Skin& skin = model.skins[static_cast<std::size_t>(k)];
+        const std::string what = "skins[" + std::to_string(k) + "]";
+        std::vector<glm::dmat4> joints(skin.joints.size(), glm::dmat4(1.0));
+        if (skin.inverseBindMatrices >= 0) {
+            const AccessorReader ibm(model, skin.inverseBindMatrices, path, what + " inverseBindMatrices");
+            if (ibm.components() != 16) fail(path, ibm.what() + ": inverseBindMatrices must be MAT4");
+            if (ibm.count() != joints.size())
+                fail(path, ibm.what() + ": has " + std::to_string(ibm.count()) + " matrices for " +
+                               std::to_string(joints.size()) + " joints");
+            for (std::size_t j = 0; j < joints.size(); ++j)
+                for (int c = 0; c < 16; ++c) joints[j][c / 4][c % 4] = ibm.get(j, c);  // (column-major)
+        }
+        for (std::size_t j = 0; j < joints.size(); ++j) {
+            const int node = skin.joints[j];
+            if (node < 0 || static_cast<std::size_t>(node) >= model.nodes.size())
+                fail(path, what + ": joint " + std::to_string(j) + " is node " + std::to_string(node) +
+                               ", which does not exist");
+            joints[j] = global_matrix(node) * joints[j];
+        }
+        return joints;
+    }
+
+    /// Moves each vertex by its joints' matrices weighted by its weights (JOINTS_n / WEIGHTS_n, every
+    /// set the primitive has): linear blend skinning, into the scene's space.
+    void apply_skin(const tinygltf::Primitive& prim, const std::vector<glm::dmat4>& joints,
+                    std::vector<glm::dvec3>& positions, const std::string& what) {
+        std::vector<glm::dmat4> blend(positions.size(), glm::dmat4(0.0));
+        for (int set = 0;; ++set) {
+            const auto j_it = prim.attributes.find("JOINTS_" + std::to_string(set));
+            const auto w_it = prim.attributes.find("WEIGHTS_" + std::to_string(set));
+            if (j_it == prim.attributes.end() || w_it == prim.attributes.end()) break;
+            const AccessorReader index(model, j_it->second, path, what + " JOINTS_" + std::to_string(set));
+            const AccessorReader weight(model, w_it->second, path, what + " WEIGHTS_" + std::to_string(set));
+            const int it = index.component_type(), wt = weight.component_type();
+            if (index.components() != 4 || index.normalized() ||
+                (it != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && it != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT))
+                fail(path, index.what() + ": JOINTS must be VEC4 of unsigned byte or short");
+            if (weight.components() != 4 ||
+                (wt != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+                 !((wt == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || wt == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
+                   weight.normalized())))
+                fail(path, weight.what() + ": WEIGHTS must be VEC4 of float or normalized unsigned byte or short");
+            for (const AccessorReader* r : {&index, &weight})
+                if (r->count() != positions.size())
+                    fail(path, r->what() + ": has " + std::to_string(r->count()) + " elements, POSITION " +
+                                   std::to_string(positions.size()));
+            for (std::size_t i = 0; i < positions.size(); ++i)
+                for (int c = 0; c < 4; ++c) {
+                    const double w = weight.get(i, c);
+                    if (w == 0.0) continue;
+                    const double j = index.get(i, c);
+                    if (j >= static_cast<double>(joints.size()))
+                        fail(path, index.what() + ": vertex " + std::to_string(i) + " names joint " +
+                                       std::to_string(static_cast<long long>(j)) + " of " +
+                                       std::to_string(joints.size()));
+                    blend[i] += w * joints[static_cast<std::size_t>(j)];
+                }
+        }
+        for (std::size_t i = 0; i < positions.size(); ++i)
+            positions[i] = glm::dvec3(blend[i] * glm::dvec4(positions[i], 1.0));
+    }
+
+    /// The mesh of a primitive, its positions moved by its morph targets at `weights` (morph_weights)
+    /// and, when `skin` is not −1, by that skin's `joints` (joint_matrices).
+    std::shared_ptr<Mesh> primitive_mesh(int mesh_index, int prim_index, const std::vector<double>& weights, int skin,
+                                         const std::vector<glm::dmat4>& joints) {
+        const auto key = std::make_tuple(mesh_index, prim_index, weights, skin);
         if (auto it = mesh_cache.find(key); it != mesh_cache.end()) return it->second;
         const tinygltf::Primitive& prim = model.meshes[mesh_index].primitives[prim_index];
         const std::string what =
@@ -750,9 +874,13 @@ struct GltfLoader {
         if (pos_it == prim.attributes.end()) fail(path, what + ": no POSITION attribute");
         const AccessorReader pos(model, pos_it->second, path, what + " POSITION");
         if (pos.components() != 3) fail(path, pos.what() + ": POSITION must be VEC3");
-        mesh->positions.resize(pos.count());
+        std::vector<glm::dvec3> positions(pos.count());
         for (std::size_t i = 0; i < pos.count(); ++i)
-            mesh->positions[i] = glm::vec3(pos.get(i, 0), pos.get(i, 1), pos.get(i, 2));
+            positions[i] = glm::dvec3(pos.get(i, 0), pos.get(i, 1), pos.get(i, 2));
+        morph(prim, weights, positions, what);
+        if (skin >= 0) apply_skin(prim, joints, positions, what);
+        mesh->positions.resize(pos.count());
+        for (std::size_t i = 0; i < pos.count(); ++i) mesh->positions[i] = glm::vec3(positions[i]);
 
         // Vertex colours (linear); premultiplied by their alpha when the material blends or masks,
         // opaque otherwise (alpha is ignored for OPAQUE materials).
@@ -851,15 +979,26 @@ struct GltfLoader {
             const tinygltf::Mesh& m = model.meshes[node.mesh];
             std::vector<Draw> draws;  // one per triangle primitive, at the node's world matrix
             std::uint64_t triangles = 0;
+            const std::vector<double> weights = morph_weights(node, index, m);
+            const std::vector<glm::dmat4> joints =
+                node.skin >= 0 ? joint_matrices(node.skin) : std::vector<glm::dmat4>{};
             for (std::size_t p = 0; p < m.primitives.size(); ++p) {
                 const tinygltf::Primitive& prim = m.primitives[p];
                 if (!draws_triangles(prim.mode)) {
                     ++skipped_primitives;
                     continue;
                 }
+                // A skinned primitive's vertices are placed by its joints alone: the spec has the
+                // node's own transform ignored.
+                const bool skinned =
+                    node.skin >= 0 && prim.attributes.count("JOINTS_0") && prim.attributes.count("WEIGHTS_0");
+                if (node.skin >= 0 && !skinned)
+                    warn_once("node " + std::to_string(index) + " has a skin, but its mesh's primitive " +
+                              std::to_string(p) + " has no JOINTS_0 and WEIGHTS_0: drawn unskinned, at the node");
                 Draw draw;
-                draw.mesh = primitive_mesh(node.mesh, static_cast<int>(p)).get();
-                draw.model = world;
+                const int skin = skinned ? node.skin : -1;
+                draw.mesh = primitive_mesh(node.mesh, static_cast<int>(p), weights, skin, joints).get();
+                draw.model = skinned ? glm::dmat4(1.0) : world;
                 apply_material(draw, prim, node.mesh, static_cast<int>(p));
                 triangles += draw.mesh->triangles.size();
                 draws.push_back(draw);
@@ -1114,8 +1253,7 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
     check_required_extensions(model, path);
     if (!ok) fail(path, "cannot read glTF: " + trim(err.empty() ? warn : err));
 
-    check_single_parents(model, path);
-    GltfLoader g(model, path, embedded);
+    GltfLoader g(model, path, embedded, node_parents(model, path));
     // tinygltf's notes about external image files it could not read are dropped: images are
     // loaded (or warned about, naming the material) by image_texture.
     std::istringstream lines(warn);
