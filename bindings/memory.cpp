@@ -31,10 +31,11 @@ void bind_memory(py::module_& m) {
         [](const py::int_& bytes) {  // (any Python int: one beyond 64 bits failed as "incompatible arguments")
             const std::string text = py::str(bytes);
             if (PyBool_Check(bytes.ptr())) throw py::type_error("memory limit: expected an integer, got bool " + text);
-            if (text[0] == '-') throw py::value_error("memory limit: expected bytes >= 0 (0 = the default), got " + text);
             const unsigned long long value = PyLong_AsUnsignedLongLong(bytes.ptr());
-            if (PyErr_Occurred()) {
+            if (PyErr_Occurred()) {  // (an OverflowError: negative, or past 64 bits)
                 PyErr_Clear();
+                if (PyObject_RichCompareBool(bytes.ptr(), py::int_(0).ptr(), Py_LT) == 1)
+                    throw py::value_error("memory limit: expected bytes >= 0 (0 = the default), got " + text);
                 throw py::value_error("memory limit: " + text + " bytes is beyond 2^64 - 1");
             }
             set_memory_limit(static_cast<std::uint64_t>(value));

@@ -385,7 +385,7 @@ struct GltfLoader {
     const std::string& path;
     const EmbeddedImages& embedded;
     LoadedScene scene;
-    // (mesh, primitive, morph weights, skinned node or −1) → mesh
+    // (mesh, primitive, morph weights, skin or −1) → mesh
     std::map<std::tuple<int, int, std::vector<double>, int>, std::shared_ptr<Mesh>> mesh_cache;
     std::map<std::pair<int, bool>, Texture> texture_cache;            // (image, ignore alpha) → texture
     std::set<std::string> warned;                                     // warnings given once
@@ -822,7 +822,7 @@ struct GltfLoader {
     /// set the primitive has): linear blend skinning, into the scene's space.
     void apply_skin(const tinygltf::Primitive& prim, const std::vector<glm::dmat4>& joints,
                     std::vector<glm::dvec3>& positions, const std::string& what) {
-        std::vector<glm::dmat4> blend(positions.size(), glm::dmat4(0.0));
+        std::vector<glm::dvec3> skinned(positions.size(), glm::dvec3(0.0));  // Σ weight · joint · position
         for (int set = 0;; ++set) {
             const auto j_it = prim.attributes.find("JOINTS_" + std::to_string(set));
             const auto w_it = prim.attributes.find("WEIGHTS_" + std::to_string(set));
@@ -851,11 +851,10 @@ struct GltfLoader {
                         fail(path, index.what() + ": vertex " + std::to_string(i) + " names joint " +
                                        std::to_string(static_cast<long long>(j)) + " of " +
                                        std::to_string(joints.size()));
-                    blend[i] += w * joints[static_cast<std::size_t>(j)];
+                    skinned[i] += w * glm::dvec3(joints[static_cast<std::size_t>(j)] * glm::dvec4(positions[i], 1.0));
                 }
         }
-        for (std::size_t i = 0; i < positions.size(); ++i)
-            positions[i] = glm::dvec3(blend[i] * glm::dvec4(positions[i], 1.0));
+        positions = std::move(skinned);
     }
 
     /// The mesh of a primitive, its positions moved by its morph targets at `weights` (morph_weights)
