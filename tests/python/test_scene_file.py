@@ -212,6 +212,27 @@ def test_gltf_node_chain_deeper_than_the_limit_is_named_as_such(tmp_path, depth,
     assert "cycle" not in str(e.value)
 
 
+@pytest.mark.parametrize("asset, message", [
+    ({"version": "2.1"}, None),
+    ({"version": "2.0", "minVersion": "2.0"}, None),
+    ({"version": "1.0"}, r"glTF version '1\.0' is not supported \(this loader reads glTF 2\.x\)"),
+    ({"version": "3.0"}, r"glTF version '3\.0' is not supported"),
+    ({"version": "2.1", "minVersion": "2.1"}, r"the file needs glTF 2\.1 \(asset\.minVersion\)"),
+])
+def test_gltf_of_another_version_is_an_error_naming_it(tmp_path, asset, message):
+    # (a 1.0 or 3.0 file was read as 2.0; the spec has loaders refuse another major version, or a
+    # minVersion above theirs)
+    path = write_gltf(tmp_path / "versioned.gltf")
+    doc = json.loads(path.read_text())
+    doc["asset"] = asset
+    path.write_text(json.dumps(doc))
+    if message is None:
+        assert len(mr.load_scene(path)[0].draws) == 1
+        return
+    with pytest.raises(OSError, match=r"versioned\.gltf: " + message):
+        mr.load_scene(path)
+
+
 @pytest.mark.parametrize("factor", [[1e39, 0, 0, 1], [1e30, 1, 1, 1e30]])
 def test_gltf_base_color_beyond_float_is_an_error_naming_the_material(tmp_path, factor):
     # a component past float's range, or (BLEND) a colour times alpha past it

@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -1210,6 +1211,19 @@ std::string unapplied_extension_effect(const std::string& extension) {
     return "this loader does not know it, and whatever it changes is not drawn";
 }
 
+/// glTF 2.x only: a file of another major version (1.0 lays its objects out otherwise) or whose
+/// minVersion is above 2.0 is an error naming the version, as the spec has loaders refuse them.
+void check_version(const tinygltf::Model& model, const std::string& path) {
+    int major = 0, minor = 0;
+    const auto parses = [&](const std::string& v) { return std::sscanf(v.c_str(), "%d.%d", &major, &minor) == 2; };
+    const std::string& version = model.asset.version;
+    if (!version.empty() && (!parses(version) || major != 2))
+        fail(path, "glTF version '" + version + "' is not supported (this loader reads glTF 2.x)");
+    const std::string& least = model.asset.minVersion;
+    if (!least.empty() && (!parses(least) || major != 2 || minor != 0))
+        fail(path, "the file needs glTF " + least + " (asset.minVersion); this loader reads glTF 2.0");
+}
+
 /// A file that requires another extension (compressed geometry, other image formats, …) cannot
 /// be drawn right: an error naming it. tinygltf only records the list, and without this the load
 /// failed later on what the extension changes, e.g. "accessor[1] invalid bufferView" for Draco.
@@ -1249,6 +1263,7 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
     }
     // tinygltf reads extensionsRequired before the buffers and accessors, so the list is there even
     // when the load failed on what an unsupported extension changes: that is the error to report.
+    check_version(model, path);
     check_required_extensions(model, path);
     if (!ok) fail(path, "cannot read glTF: " + trim(err.empty() ? warn : err));
 
