@@ -735,12 +735,24 @@ struct GltfLoader {
     /// (glTF 2.0), and in files that use KHR_mesh_quantization also byte and short (normalized or
     /// not) and unnormalized unsigned byte/short, read as their integer values.
     bool texcoord_type_allowed(int type, bool normalized) const {
-        if (type == TINYGLTF_COMPONENT_TYPE_FLOAT) return true;
-        const bool small_unsigned =
-            type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
-        if (small_unsigned && normalized) return true;
-        return quantized &&
-               (small_unsigned || type == TINYGLTF_COMPONENT_TYPE_BYTE || type == TINYGLTF_COMPONENT_TYPE_SHORT);
+        if (float_or_unit_unsigned(type, normalized)) return true;
+        return quantized && (type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                             type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT || type == TINYGLTF_COMPONENT_TYPE_BYTE ||
+                             type == TINYGLTF_COMPONENT_TYPE_SHORT);
+    }
+
+    /// Float, or normalized unsigned byte/short: glTF 2.0's types for colours, weights and uvs.
+    static bool float_or_unit_unsigned(int type, bool normalized) {
+        return type == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+               ((type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
+                normalized);
+    }
+
+    /// An error unless vertex attribute r (`name` in the message) has one element per vertex.
+    void check_per_vertex(const AccessorReader& r, const std::string& name, std::size_t vertices) const {
+        if (r.count() != vertices)
+            fail(path, r.what() + ": " + name + " has " + std::to_string(r.count()) + " elements, POSITION " +
+                           std::to_string(vertices));
     }
 
     /// The morph target weights a node's mesh is drawn at: the node's, else the mesh's defaults
@@ -767,9 +779,7 @@ struct GltfLoader {
             if (weights[t] == 0.0 || it == prim.targets[t].end()) continue;
             const AccessorReader d(model, it->second, path, what + " targets[" + std::to_string(t) + "] POSITION");
             if (d.components() != 3) fail(path, d.what() + ": POSITION must be VEC3");
-            if (d.count() != positions.size())
-                fail(path, d.what() + ": has " + std::to_string(d.count()) + " elements, POSITION " +
-                               std::to_string(positions.size()));
+            check_per_vertex(d, "the target's POSITION", positions.size());
             for (std::size_t i = 0; i < positions.size(); ++i)
                 positions[i] += weights[t] * glm::dvec3(d.get(i, 0), d.get(i, 1), d.get(i, 2));
         }
@@ -830,19 +840,14 @@ struct GltfLoader {
             if (j_it == prim.attributes.end() || w_it == prim.attributes.end()) break;
             const AccessorReader index(model, j_it->second, path, what + " JOINTS_" + std::to_string(set));
             const AccessorReader weight(model, w_it->second, path, what + " WEIGHTS_" + std::to_string(set));
-            const int it = index.component_type(), wt = weight.component_type();
+            const int it = index.component_type();
             if (index.components() != 4 || index.normalized() ||
                 (it != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && it != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT))
                 fail(path, index.what() + ": JOINTS must be VEC4 of unsigned byte or short");
-            if (weight.components() != 4 ||
-                (wt != TINYGLTF_COMPONENT_TYPE_FLOAT &&
-                 !((wt == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || wt == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
-                   weight.normalized())))
+            if (weight.components() != 4 || !float_or_unit_unsigned(weight.component_type(), weight.normalized()))
                 fail(path, weight.what() + ": WEIGHTS must be VEC4 of float or normalized unsigned byte or short");
-            for (const AccessorReader* r : {&index, &weight})
-                if (r->count() != positions.size())
-                    fail(path, r->what() + ": has " + std::to_string(r->count()) + " elements, POSITION " +
-                                   std::to_string(positions.size()));
+            check_per_vertex(index, "JOINTS_" + std::to_string(set), positions.size());
+            check_per_vertex(weight, "WEIGHTS_" + std::to_string(set), positions.size());
             for (std::size_t i = 0; i < positions.size(); ++i)
                 for (int c = 0; c < 4; ++c) {
                     const double w = weight.get(i, c);
@@ -888,14 +893,9 @@ struct GltfLoader {
             const AccessorReader col(model, col_it->second, path, what + " COLOR_0");
             if (col.components() != 3 && col.components() != 4)
                 fail(path, col.what() + ": COLOR_0 must be VEC3 or VEC4");
-            const int ct = col.component_type();
-            if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT &&
-                !((ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE || ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) &&
-                  col.normalized()))
+            if (!float_or_unit_unsigned(col.component_type(), col.normalized()))
                 fail(path, col.what() + ": COLOR_0 must be float or normalized unsigned byte/short");
-            if (col.count() != pos.count())
-                fail(path, col.what() + ": COLOR_0 has " + std::to_string(col.count()) + " elements, POSITION " +
-                               std::to_string(pos.count()));
+            check_per_vertex(col, "COLOR_0", pos.count());
             const bool alpha = material_uses_alpha(prim.material);
             mesh->colors.resize(col.count());
             for (std::size_t i = 0; i < col.count(); ++i) {
@@ -921,9 +921,7 @@ struct GltfLoader {
                                             "KHR_mesh_quantization)"
                                           : "") +
                                ", got component type " + std::to_string(ct) + (uv.normalized() ? " (normalized)" : ""));
-            if (uv.count() != pos.count())
-                fail(path, uv.what() + ": " + uv_name + " has " + std::to_string(uv.count()) + " elements, POSITION " +
-                               std::to_string(pos.count()));
+            check_per_vertex(uv, uv_name, pos.count());
             mesh->uvs.resize(uv.count());
             for (std::size_t i = 0; i < uv.count(); ++i) {
                 const glm::dvec2 value(uv.get(i, 0), uv.get(i, 1));
@@ -940,9 +938,7 @@ struct GltfLoader {
                 !((ct == TINYGLTF_COMPONENT_TYPE_BYTE || ct == TINYGLTF_COMPONENT_TYPE_SHORT) && nrm.normalized()))
                 fail(path, nrm.what() + ": NORMAL must be float or normalized byte/short, got component type " +
                                std::to_string(ct));
-            if (nrm.count() != pos.count())
-                fail(path, nrm.what() + ": NORMAL has " + std::to_string(nrm.count()) + " elements, POSITION " +
-                               std::to_string(pos.count()));
+            check_per_vertex(nrm, "NORMAL", pos.count());
             mesh->normals.resize(nrm.count());
             for (std::size_t i = 0; i < nrm.count(); ++i)
                 mesh->normals[i] = glm::vec3(nrm.get(i, 0), nrm.get(i, 1), nrm.get(i, 2));
