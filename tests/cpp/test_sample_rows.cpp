@@ -1,5 +1,5 @@
-// Sample rows (RenderSettings::sample_rows): at one sample per pixel or SSAA, a depth-tested
-// triangle's coverage, screen weights and depth tests along a row run four pixels per vector
+// Sample rows (RenderSettings::sample_rows): at one sample per pixel or SSAA, a triangle's
+// coverage, screen weights and depth tests (if any) along a row run four pixels per vector
 // (sample by sample under SSAA); under MSAA a pixel's depth tests run four samples per vector.
 // Colour, depth and every counter are bit for bit those of the per-sample path — for both depth conventions, every blend and interpolation, textured or not,
 // depth written or only read, with and without block skipping and deferred shading — including
@@ -53,13 +53,16 @@ TEST(SampleRows, SameBitsAndCountersAsThePerSamplePathOnOverlappingScenes) {
                     mr::DrawState read_only = tested;
                     read_only.depth_write = false;
                     // Textured; the same triangles again at the same depths (every test ties and fails);
-                    // untextured, read-only and flat; then a draw without depth test.
+                    // untextured, read-only and flat; then two draws without depth test, untextured
+                    // and textured.
                     std::vector<mr::Draw> draws = {make_draw(a, glm::dmat4(1.0), tested),
                                                    make_draw(a, glm::dmat4(1.0), tested, glm::vec4(0.2f, 0.9f, 0.4f, 1.0f)),
                                                    make_draw(b, shifted, tested),
                                                    make_draw(b, glm::dmat4(1.0), read_only, glm::vec4(0.9f, 0.8f, 1.0f, 1.0f)),
-                                                   make_draw(a, shifted, no_depth(blend), glm::vec4(0.5f))};
+                                                   make_draw(a, shifted, no_depth(blend), glm::vec4(0.5f)),
+                                                   make_draw(b, glm::dmat4(1.0), no_depth(blend))};
                     draws[0].texture = texture;
+                    draws[5].texture = texture;  // (textured without a depth test: rows of every mode)
                     draws[3].state.interpolation = mr::Interpolation::flat;
                     draws[4].mesh = &b;
                     // One sample per pixel, SSAA (rows sample by sample) and MSAA (a pixel's
@@ -190,35 +193,54 @@ TEST(SampleRows, AlphaTestedRowsGiveThePerSampleBits) {
     EXPECT_GT(discarded, 1000u);
 }
 
-TEST(SampleRows, UntexturedRowsColouredInBatchesGiveThePerSampleBits) {
-    // Untextured screen and perspective shading colours a row's passed pixels in batches
-    // (interpolate_colours), skipping the weighted sums of one-colour triangles: the per-sample
-    // bits for vertex colours, one colour per triangle, and one colour with a +0 or −0 channel
-    // (where the sums must run: they can give the other signed zero).
+// Untextured screen and perspective shading of a triangle whose three vertex colours are one
+// colour takes that colour without the weighted sums (raster_tile's one_colour): flat shading's
+// bits, the interpolation's exactly (a weighted sum clamped to [c, c]), at one sample, SSAA and
+// MSAA, with and without sample rows and deferred shading. With a +0 or −0 channel the sums run
+// (they can give the other signed zero): equal as numbers.
+TEST(SampleRows, UntexturedOneColourTrianglesGiveFlatShadingsColour) {
     const int W = 96, H = 80;
-    const mr::Mesh coloured = overlapping(150, 2.5, 43);
-    mr::Mesh tinted = coloured;
+    mr::Mesh tinted = overlapping(150, 2.5, 43), zeros = tinted;
     for (std::size_t v = 0; v < tinted.colors.size(); ++v) {
-        tinted.colors[v] = tinted.colors[v - v % 3];
-        if (v / 3 % 4 == 1) tinted.colors[v].g = 0.0f;
-        if (v / 3 % 4 == 2) tinted.colors[v].b = -0.0f;
+        tinted.colors[v] = tinted.colors[v - v % 3];  // (every channel of overlapping's colours > 0)
+        zeros.colors[v] = tinted.colors[v];
+        if (v / 3 % 4 == 1) zeros.colors[v].g = 0.0f;
+        if (v / 3 % 4 == 2) zeros.colors[v].b = -0.0f;
     }
+    for (const glm::vec4& c : tinted.colors)
+        for (int k = 0; k < 4; ++k) ASSERT_GT(c[k], 0.0f);
     const mr::Camera cam = overlap_camera(mr::DepthConvention::reverse_z, W, H);
-    for (const mr::Mesh* mesh : std::initializer_list<const mr::Mesh*>{&coloured, &tinted})
+    for (const mr::Mesh* mesh : {&tinted, &zeros})
         for (mr::BlendMode blend : {mr::BlendMode::replace, mr::BlendMode::over})
             for (mr::Interpolation interpolation : {mr::Interpolation::perspective, mr::Interpolation::screen})
-                for (int samples : {1, 4}) {
-                    SCOPED_TRACE(std::string(mesh == &tinted ? "tinted, " : "") + mr::to_string(blend) + ", " +
-                                 mr::to_string(interpolation) + ", " + std::to_string(samples) + " samples");
-                    mr::DrawState state;
-                    state.blend = blend;
-                    state.interpolation = interpolation;
-                    const std::vector<mr::Draw> draws = {make_draw(*mesh, glm::dmat4(1.0), state, glm::vec4(0.9f, 0.7f, 1.0f, 0.8f))};
-                    auto s = settings(W, H, samples);
-                    s.anti_aliasing = mr::AntiAliasing::ssaa;
-                    s.clear_color = glm::vec4(0.1f, -0.0f, 0.3f, 1.0f);
-                    expect_same_with_and_without_rows(draws, cam, s);
-                }
+                for (const auto& [samples, aa] : {std::pair{1, mr::AntiAliasing::ssaa}, std::pair{4, mr::AntiAliasing::ssaa},
+                                                  std::pair{4, mr::AntiAliasing::msaa}})
+                    for (bool rows : {false, true})
+                        for (bool deferred : {false, true}) {
+                            SCOPED_TRACE(std::string(mesh == &zeros ? "zeros, " : "") + mr::to_string(blend) + ", " +
+                                         mr::to_string(interpolation) + ", " + std::to_string(samples) + " samples " +
+                                         mr::to_string(aa) + (rows ? ", rows" : "") + (deferred ? ", deferred" : ""));
+                            mr::DrawState state;
+                            state.blend = blend;
+                            state.interpolation = interpolation;
+                            mr::DrawState flat = state;
+                            flat.interpolation = mr::Interpolation::flat;
+                            auto s = settings(W, H, samples);
+                            s.anti_aliasing = aa;
+                            s.sample_rows = rows;
+                            s.deferred_shading = deferred;
+                            s.clear_color = glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+                            const glm::vec4 tint(0.9f, 0.7f, 1.0f, 0.8f);
+                            const mr::RenderResult got = mr::render({make_draw(*mesh, glm::dmat4(1.0), state, tint)}, cam, s);
+                            const mr::RenderResult want = mr::render({make_draw(*mesh, glm::dmat4(1.0), flat, tint)}, cam, s);
+                            EXPECT_GT(got.stats.samples_passed, 0u);
+                            if (mesh == &tinted) {
+                                expect_same_render(got, want);
+                            } else {
+                                EXPECT_EQ(got.color.pixels, want.color.pixels);
+                                EXPECT_EQ(got.framebuffer.color, want.framebuffer.color);
+                            }
+                        }
 }
 
 TEST(SampleRows, SamplesOnEdgesFollowTheTopLeftRule) {
@@ -335,7 +357,9 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
             e[trial % 3] += ((std::int64_t{1} << 50) + static_cast<std::int64_t>(rng() % (std::uint64_t{1} << 52))) *
                             (trial % 100 == 25 ? 1 : -1);
         const std::uint32_t tested = static_cast<std::uint32_t>(rng());
-        const mr::DepthFunc func = rng() % 2 ? mr::DepthFunc::greater : mr::DepthFunc::less;
+        // (none: every covered pixel of `tested` passes, depth neither read nor written)
+        const mr::DepthFunc func =
+            std::array{mr::DepthFunc::greater, mr::DepthFunc::less, mr::DepthFunc::none}[rng() % 3];
         const bool depth_write = rng() % 2;
         const int stride = std::array<int, 4>{1, 1, 4, 5}[trial % 4];  // one sample per pixel, or one of S
 
@@ -369,11 +393,12 @@ TEST(SampleRows, BothVectorWidthsGiveThePerSampleArithmeticOnRandomRows) {
             want_depth[j] = stored[j];
             if ((E[0] | E[1] | E[2]) < 0) continue;
             want_covered |= 1u << j;
-            const bool wins = func == mr::DepthFunc::greater ? z > stored[j] : z < stored[j];
+            const bool wins = func == mr::DepthFunc::none ||
+                              (func == mr::DepthFunc::greater ? z > stored[j] : z < stored[j]);
             if (!(tested >> j & 1) || !wins) continue;
             want_passed |= 1u << j;
             want_l[0][j] = l.x, want_l[1][j] = l.y, want_l[2][j] = l.z;
-            if (depth_write) want_depth[j] = z;
+            if (depth_write && func != mr::DepthFunc::none) want_depth[j] = z;
         }
 
         const auto check = [&](const char* path, auto row_test) {

@@ -47,9 +47,9 @@ inline void shade_into(LookupQueue<kBlend, kShading, kTexturing>* queue, float* 
     blend_into_samples<kBlend>(target, samples, c);
 }
 
-// Untextured screen or perspective shading: a sample row's passed pixels are coloured a batch at
-// a time (interpolate_colours); one at a time, their perspective weights and sums were half of
-// the kernel. (Constant and flat colours cost nothing to shade.)
+// Untextured screen or perspective shading: deferred shading's runs of pixels are coloured a batch
+// at a time (interpolate_colours), and a triangle of one colour takes it without the sums. (Constant
+// and flat colours cost nothing to shade.)
 template <Shading kShading, Texturing kTexturing>
 inline constexpr bool kColoursByRow =
     kTexturing == Texturing::none && (kShading == Shading::screen || kShading == Shading::perspective);
@@ -369,6 +369,12 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
             return VertexValues{};
         }();
+        // Untextured screen or perspective shading of three equal vertex colours (batch_shading):
+        // every sample's colour is flat's, the same bits, without its weights and sums.
+        std::optional<glm::vec4> one_colour;
+        if constexpr (kColoursByRow<kShading, kTexturing>)
+            if (t.clip_index < 0 && batch_shading(kShading, colors) == Shading::flat)
+                one_colour = untextured_colour<Shading::flat>(draw, colors, t, glm::dvec3(0.0), batch.clip_weights);
         TriangleUvs uvs;
         if constexpr (kTexturing != Texturing::none) {
             uvs = TriangleUvs(t, draw.triangles[t.triangle], draw.uvs, batch.clip_weights);
@@ -436,6 +442,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 target.barycentrics.data[2 * i + 1] = static_cast<float>(w.z);
             } else {
                 ++counters.shader_invocations;
+                if (one_colour) return blend_into<kBlend>(color_px + 4 * s, *one_colour);
                 shade_into<kBlend, kShading, kTexturing>(queue ? &*queue : nullptr, color_px + 4 * s, std::uint64_t{1},
                                                          draw, colors, uvs, t, l, batch.clip_weights, px, py);
             }
@@ -470,15 +477,10 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         };
 
         // The passed pixels of a row's sample s (bit j: pixel rx0 + j) at once, as passed_sample takes
-        // them one by one: for queued lookups, untextured colours by row and the deferred pre-pass's
-        // owners (false: none of them).
-        constexpr bool kColours = kColoursByRow<kShading, kTexturing>;
-        std::optional<Shading> row_shading;  // batch_shading, when a row first needs it
+        // them one by one: for queued lookups and the deferred pre-pass's owners (false: neither).
         const auto passed_row = [&](int rx0, int py, int s, const SampleRow& row) {
             if constexpr (kShading == Shading::visibility) {
                 if (!target.owners) return false;
-            } else if constexpr (kColours) {
-                if (t.clip_index >= 0) return false;  // (original_weights: the per-sample path)
             } else if (!queue) {
                 return false;
             }
@@ -490,13 +492,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 for (std::uint32_t m = row.passed; m; m &= m - 1) owners[__builtin_ctz(m) * S] = owner;
             } else {
                 counters.shader_invocations += passed;
-                if constexpr (kColours) {
-                    if (!row_shading) row_shading = batch_shading(kShading, colors);
-                    shade_row_colours<kBlend>(color_out.at(rx0, py, s), 4 * S, row.passed, row.l0, row.l1, row.l2, draw,
-                                              *row_shading, colors, t);
-                } else {
-                    queue->push_row(color_out.at(rx0, py, s), 4 * S, row.passed, row.l0, row.l1, row.l2, rx0, py);
-                }
+                queue->push_row(color_out.at(rx0, py, s), 4 * S, row.passed, row.l0, row.l1, row.l2, rx0, py);
             }
             return true;
         };
@@ -550,6 +546,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 record_owner(px, py, passed, at_centre);  // (the shade below, deferred)
             } else {
                 ++counters.shader_invocations;
+                if (one_colour) return blend_into_samples<kBlend>(color_px, passed, *one_colour);
                 glm::dvec3 l(0.0);  // (unused by constant and flat untextured shading)
                 if constexpr (!((kShading == Shading::constant || kShading == Shading::flat) &&
                                 kTexturing == Texturing::none)) {
@@ -573,14 +570,27 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         // the triangle, else at its first sample that passed.
         const auto msaa_row = [&](int rx0, int py, int n, const std::int64_t (&corner)[3]) {
             std::uint64_t samples[kTileSize];  // per pixel, the samples that passed
-            const double* const offsets[3] = {offset0, offset1, offset2};
-            const PixelRowTest found = test_pixel_row_avx2(t, corner, n, offsets, S, kDepth, draw.depth_write,
-                                                           depth_out.at(rx0, py, 0), samples);
-            counters.samples_covered += found.covered;
-            counters.samples_passed += found.passed;
-            const std::uint32_t pixels = found.pixels;
-            if (!pixels) return;
-            blocks.written_row(py, rx0, pixels);
+            std::uint32_t pixels = 0;
+            if constexpr (kDepth == DepthFunc::none) {  // (every covered sample passes)
+                pixel_coverage_avx2(corner, {off0, off1, off2}, {step0, step1, step2}, n, S, samples);
+                std::uint64_t covered = 0;
+                for (int j = 0; j < n; ++j) {
+                    covered += static_cast<std::uint64_t>(count_bits(samples[j]));
+                    pixels |= static_cast<std::uint32_t>(samples[j] != 0) << j;
+                }
+                counters.samples_covered += covered;
+                counters.samples_passed += covered;
+                if (!pixels) return;
+            } else {
+                const double* const offsets[3] = {offset0, offset1, offset2};
+                const PixelRowTest found = test_pixel_row_avx2(t, corner, n, offsets, S, kDepth, draw.depth_write,
+                                                               depth_out.at(rx0, py, 0), samples);
+                counters.samples_covered += found.covered;
+                counters.samples_passed += found.passed;
+                pixels = found.pixels;
+                if (!pixels) return;
+                blocks.written_row(py, rx0, pixels);
+            }
             const std::int64_t centre[3] = {corner[0] + to_centre0, corner[1] + to_centre1, corner[2] + to_centre2};
             const std::uint32_t centres = row_coverage_avx2(centre, {step0, step1, step2}, n);  // bit j: inside
             if constexpr (kShading == Shading::visibility) {
@@ -686,10 +696,14 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             const std::int64_t row2 = t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2];
             const int n = rx1 - rx0;
 
-            // Depth tested, every sample shaded (one per pixel, or SSAA): the row four pixels at a
-            // time, sample by sample (sample_row.hpp). With several samples, only where none of
-            // their rows can be refused; one sample's refused row takes the per-sample path.
-            if constexpr (kMode != SampleMode::msaa && kDepth != DepthFunc::none) {
+            // Textured (or the deferred pre-pass), every sample shaded (one per pixel, or SSAA):
+            // the row four pixels at a time, sample by sample (sample_row.hpp), depth tested or not.
+            // With several samples, only where none of their rows can be refused; one sample's
+            // refused row takes the per-sample path. (Textured without a depth test: plane 1x −9 %,
+            // SSAA 4x −17 %. Untextured, the per-pixel path is faster: a depth-tested 1080p grid of
+            // 20,000 vertex-coloured triangles took 33 ms by rows, 23 without.)
+            if constexpr (kMode != SampleMode::msaa &&
+                          (kTexturing != Texturing::none || kShading == Shading::visibility)) {
                 bool rows = target.sample_rows && n >= kSampleRowMinPixels &&
                             (kMode == SampleMode::single || sample_rows_exact(t, {row0, row1, row2}, n));
                 if (rows) {
@@ -698,7 +712,8 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                     // A multiple of four samples with AVX2: four rows at once, their depths four
                     // pixels a vector. (No row is refused past sample 0: sample_rows_exact holds.)
                     SampleRow four[4];
-                    const bool fours = kMode == SampleMode::ssaa && vector_masks;
+                    const bool fours = kMode == SampleMode::ssaa && vector_masks && kDepth != DepthFunc::none;
+                    float* const depth_row = kDepth != DepthFunc::none ? depth_out.at(rx0, py, 0) : nullptr;
                     for (int s = 0; rows && s < S; ++s) {
                         SampleRow single_row;
                         if (fours && s % 4 == 0) {
@@ -708,7 +723,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                                 e[k][2] = row2 + off2[s + k];
                             }
                             if (!test_four_sample_rows_avx2(t, e, n, ~untested, kDepth, draw.depth_write,
-                                                            depth_out.at(rx0, py, s), S, four)) {
+                                                            depth_row + s, S, four)) {
                                 rows = false;
                                 break;
                             }
@@ -716,14 +731,14 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         if (!fours) {
                             const std::int64_t e[3] = {row0 + off0[s], row1 + off1[s], row2 + off2[s]};
                             if (!test_sample_row(t, e, n, ~untested, kDepth, draw.depth_write,
-                                                 depth_out.at(rx0, py, s), S, single_row)) {
+                                                 depth_row ? depth_row + s : nullptr, S, single_row)) {
                                 rows = false;  // (one sample, nothing done yet)
                                 break;
                             }
                         }
                         const SampleRow& row = fours ? four[s % 4] : single_row;
                         counters.samples_covered += static_cast<std::uint64_t>(count_bits(row.covered & ~skipped));
-                        if constexpr (kShading == Shading::visibility || kTexturing != Texturing::none || kColours)
+                        if constexpr (kShading == Shading::visibility || kTexturing != Texturing::none)
                             if (passed_row(rx0, py, s, row)) continue;
                         blocks.written_row(py, rx0, row.passed);
                         for (std::uint32_t m = row.passed; m; m &= m - 1) {
@@ -736,15 +751,17 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 }
             }
 
-            // MSAA, depth tested, textured (or the pre-pass of textured draws): a long row's pixels
-            // tested one after the other, four samples per vector, then shaded into the lookup queue
-            // at once (their centres' weights a row at a time), or their owners recorded: the
-            // per-pixel path's values and order (plane MSAA 4x −8 %). Not where a block is hidden:
-            // its pixels skip their tests one by one at less cost (overdraw MSAA 4x was 7 % slower).
-            if constexpr (kMode == SampleMode::msaa && kDepth != DepthFunc::none &&
+            // MSAA, textured (or the pre-pass of textured draws): a long row's pixels tested one
+            // after the other, four samples per vector, then shaded into the lookup queue at once
+            // (their centres' weights a row at a time), or their owners recorded: the per-pixel
+            // path's values and order (plane MSAA 4x −8 %; without a depth test −30 %). Not where a
+            // block is hidden: its pixels skip their tests one by one at less cost (overdraw MSAA 4x
+            // was 7 % slower).
+            if constexpr (kMode == SampleMode::msaa &&
                           (kTexturing != Texturing::none || kShading == Shading::visibility)) {
                 const bool takes_rows = kShading == Shading::visibility ? target.owners != nullptr : queue.has_value();
-                if (takes_rows && pixel_vectors && n >= kSampleRowMinPixels &&
+                const bool row_vectors = kDepth == DepthFunc::none ? vector_masks : pixel_vectors;
+                if (takes_rows && row_vectors && n >= kSampleRowMinPixels &&
                     !blocks.row_pixels(classified, py, rx0, n) && sample_rows_exact(t, {row0, row1, row2}, n)) {
                     msaa_row(rx0, py, n, {row0, row1, row2});
                     continue;

@@ -77,7 +77,7 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
     for (int i = 0; i < 3; ++i) bias[i] = _mm_set1_pd(static_cast<double>(t.bias[i]));
     const __m128d inv_area2 = _mm_set1_pd(t.inv_area2), z0 = _mm_set1_pd(t.z0), dz1 = _mm_set1_pd(t.dz1),
                   dz2 = _mm_set1_pd(t.dz2);
-    const bool greater = func == DepthFunc::greater;
+    const bool greater = func == DepthFunc::greater, tests = func != DepthFunc::none;
     out.covered = out.passed = 0;
     const __m128i lane_bit = _mm_set_epi32(8, 4, 2, 1);
     for (int j = 0; j < n; j += 4) {
@@ -103,9 +103,10 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
         const __m128 asked = _mm_and_ps(
             covered, _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(tested >> j)), lane_bit), lane_bit)));
         if (!(_mm_movemask_ps(asked) & in_row)) continue;
-        float* const stored = depth + j * stride;
-        const __m128 s = stored_depths(stored, stride, lanes);
-        const __m128 wins = _mm_and_ps(asked, greater ? _mm_cmpgt_ps(depths, s) : _mm_cmplt_ps(depths, s));
+        float* const stored = tests ? depth + j * stride : nullptr;
+        const __m128 s = tests ? stored_depths(stored, stride, lanes) : _mm_setzero_ps();
+        const __m128 wins =
+            tests ? _mm_and_ps(asked, greater ? _mm_cmpgt_ps(depths, s) : _mm_cmplt_ps(depths, s)) : asked;
         const std::uint32_t passed = static_cast<std::uint32_t>(_mm_movemask_ps(wins)) & in_row;
         if (!passed) continue;
         out.passed |= passed << j;
@@ -114,7 +115,7 @@ bool test_sample_row_sse2(const SetupTriangle& t, const std::int64_t (&e)[3], in
             _mm_storeu_pd(out.l1 + j + 2 * h, l1[h]);
             _mm_storeu_pd(out.l2 + j + 2 * h, l2[h]);
         }
-        if (depth_write) store_depths(stored, stride, lanes, passed, wins, depths, s);
+        if (tests && depth_write) store_depths(stored, stride, lanes, passed, wins, depths, s);
     }
     return true;
 }
@@ -199,7 +200,7 @@ template <bool kInside>
     splat_row_terms(t, k);
     __m256d first[3];
     for (int i = 0; i < 3; ++i) first[i] = _mm256_set1_pd(static_cast<double>(e[i] + t.bias[i]));
-    const bool greater = func == DepthFunc::greater;
+    const bool greater = func == DepthFunc::greater, tests = func != DepthFunc::none;
     out.covered = out.passed = 0;
     // Pixel indices j … j + 3 (small integers: stepping them by 4 is exact; built from j each
     // time, the conversions were a chain the loop waited on).
@@ -213,17 +214,19 @@ template <bool kInside>
         out.covered |= covered << j;
         const std::uint32_t asked = covered & (tested >> j);
         if (!asked) continue;
-        float* const stored = depth + j * stride;
-        const __m128 s = stored_depths(stored, stride, lanes);
-        const std::uint32_t passed = static_cast<std::uint32_t>(_mm_movemask_ps(
-                                         greater ? _mm_cmpgt_ps(p.depths, s) : _mm_cmplt_ps(p.depths, s))) &
-                                     asked;
+        float* const stored = tests ? depth + j * stride : nullptr;
+        const __m128 s = tests ? stored_depths(stored, stride, lanes) : _mm_setzero_ps();
+        const std::uint32_t passed =
+            tests ? static_cast<std::uint32_t>(_mm_movemask_ps(greater ? _mm_cmpgt_ps(p.depths, s)
+                                                                       : _mm_cmplt_ps(p.depths, s))) &
+                        asked
+                  : asked;
         if (!passed) continue;
         out.passed |= passed << j;
         _mm256_storeu_pd(out.l0 + j, p.l0);
         _mm256_storeu_pd(out.l1 + j, p.l1);
         _mm256_storeu_pd(out.l2 + j, p.l2);
-        if (depth_write) store_depths(stored, stride, lanes, passed, lane_mask(passed), p.depths, s);
+        if (tests && depth_write) store_depths(stored, stride, lanes, passed, lane_mask(passed), p.depths, s);
     }
     return true;
 }

@@ -30,7 +30,8 @@ bool sample_rows_exact(const SetupTriangle& t, const std::int64_t (&corner)[3], 
 
 /// Triangle t over one sample of pixels j < n of a row, whose first pixel's sample has edge values
 /// e (bias not added). Tests depth (less or greater) at the pixels of `tested` against
-/// depth[j·stride] (stride: the pixels' samples), storing the passing depths when depth_write.
+/// depth[j·stride] (stride: the pixels' samples), storing the passing depths when depth_write;
+/// with func none every covered pixel of `tested` passes and depth is neither read nor written.
 /// Returns false, touching nothing, when an edge value along the row reaches 2^52 in magnitude
 /// (its sums in double could round): the per-sample path then runs.
 bool test_sample_row(const SetupTriangle& t, const std::int64_t (&e)[3], int n, std::uint32_t tested, DepthFunc func,
