@@ -241,6 +241,11 @@ OMISSIONS = [
              Variant("depth_test=False", colour_grid(depth_test=False)),
              Variant("depth_test=True (never rejects)", colour_grid()), "exact",
              "the depth buffer is tile-local (one per worker), so the memory it saves is small"),
+    Omission("no depth buffer when nothing tests depth (textured, MSAA 4x)",
+             "colour grid with a 1×1 white texture (trilinear), MSAA 4x",
+             Variant("depth_test=False", with_options(colour_grid("trilinear", depth_test=False), spp=4, aa="msaa")),
+             Variant("depth_test=True (never rejects)", with_options(colour_grid("trilinear"), spp=4, aa="msaa")),
+             "exact"),
     Omission("no colour clear before drawing where every sample is drawn", "colour grid, MSAA 4x",
              Variant("every draw tests and writes depth and replaces colour: the samples still at the clear "
                      "depth are cleared after drawing", with_options(colour_grid(), spp=4, aa="msaa")),
