@@ -287,6 +287,44 @@ TEST(Interpolate, VertexValuesRangeIsGlmsMinAndMax) {
     }
 }
 
+// VertexValues::one against its definition per component (a == b == c, finite, nonzero): colours
+// that are one colour, and one colour with one component of one vertex changed to a special value
+// (signed zeros, infinities, a NaN) or to the next float; where it holds, the clamped weighted sum
+// at random finite weights is that colour, bit for bit.
+TEST(Interpolate, VertexValuesOneIsOneFiniteNonzeroColour) {
+    const float special[] = {0.0f, -0.0f, std::numeric_limits<float>::infinity(),
+                             -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN(), 1e-40f};
+    std::mt19937 rng(16);
+    std::uniform_real_distribution<float> value(-2.0f, 2.0f);
+    std::uniform_real_distribution<double> weight(-3.0, 3.0);
+    int ones = 0, others = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        glm::vec4 a;
+        for (int k = 0; k < 4; ++k) a[k] = trial % 7 == 0 ? special[rng() % 6] : value(rng);
+        glm::vec4 v[3] = {a, a, a};
+        if (trial % 2) {  // one component of one vertex changed
+            float& x = v[rng() % 3][static_cast<int>(rng() % 4)];
+            x = rng() % 2 ? special[rng() % 6] : std::nextafter(x, 3.0f);
+        }
+        bool want = true;
+        for (int k = 0; k < 4; ++k)
+            want = want && v[0][k] == v[1][k] && v[1][k] == v[2][k] && v[0][k] != 0.0f && std::isfinite(v[0][k]);
+        const mr::VertexValues values(v[0], v[1], v[2]);
+        ASSERT_EQ(values.one, want) << "trial " << trial;
+        (want ? ones : others) += 1;
+        if (!want) continue;
+        const glm::vec4 sum = values.interpolate(glm::dvec3(weight(rng), weight(rng), weight(rng)));
+        for (int k = 0; k < 4; ++k) {
+            std::uint32_t got_bits, want_bits;
+            std::memcpy(&got_bits, &sum[k], 4);
+            std::memcpy(&want_bits, &v[0][k], 4);
+            ASSERT_EQ(got_bits, want_bits) << "trial " << trial << " component " << k;
+        }
+    }
+    EXPECT_GT(ones, 8000);
+    EXPECT_GT(others, 8000);
+}
+
 // VertexValues::interpolate (four components at once) against its definition per component,
 // std::clamp(float(w.x·v0 + w.y·v1 + w.z·v2), lo, hi), bit for bit: weights inside and outside
 // [0, 1] (so that the clamp acts at both ends), values of large and mixed magnitudes (so that the

@@ -204,13 +204,7 @@ void interpolate(const DrawInputs& draw, Shading shading, Texturing texturing, c
 }  // namespace
 
 Shading batch_shading(Shading shading, const VertexValues& colors) {
-    if (shading != Shading::screen && shading != Shading::perspective) return shading;
-    // One finite, nonzero value per channel on all three vertices: a weighted sum (finite: the
-    // weights are) clamped to [lo, hi] = [c, c] is c with its bits. Zero is left out because a
-    // sum of −0 and +0 terms can give the other signed zero, which the clamp keeps.
-    for (int c = 0; c < 4; ++c)
-        if (!(colors.lo[c] == colors.hi[c] && colors.lo[c] != 0.0f && std::isfinite(colors.lo[c]))) return shading;
-    return Shading::flat;
+    return (shading == Shading::screen || shading == Shading::perspective) && colors.one ? Shading::flat : shading;
 }
 
 bool interpolates_in_batches(const DrawInputs& draw, Shading shading, Texturing texturing, const SetupTriangle& t) {

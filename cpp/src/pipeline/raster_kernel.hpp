@@ -369,11 +369,11 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
             return VertexValues{};
         }();
-        // Untextured screen or perspective shading of three equal vertex colours (batch_shading):
+        // Untextured screen or perspective shading of three equal vertex colours (VertexValues::one):
         // every sample's colour is flat's, the same bits, without its weights and sums.
         std::optional<glm::vec4> one_colour;
         if constexpr (kColoursByRow<kShading, kTexturing>)
-            if (t.clip_index < 0 && batch_shading(kShading, colors) == Shading::flat)
+            if (t.clip_index < 0 && colors.one)
                 one_colour = untextured_colour<Shading::flat>(draw, colors, t, glm::dvec3(0.0), batch.clip_weights);
         TriangleUvs uvs;
         if constexpr (kTexturing != Texturing::none) {

@@ -59,6 +59,11 @@ struct VertexValues {
     glm::vec4 v[3];
     glm::vec4 lo, hi;
     glm::dvec4 wide[3];  ///< v in double, once per triangle, not per sample interpolated
+    /// Every component one finite, nonzero value c at all three vertices: then a weighted sum with
+    /// finite weights, clamped to [lo, hi] = [c, c], is c with its bits. (Zero is left out: a sum
+    /// of −0 and +0 terms can give the other signed zero, which the clamp keeps. Compared vertex
+    /// by vertex, not through lo and hi, whose selections pass over a NaN.)
+    bool one = false;
 
     VertexValues() = default;
     /// lo = glm::min(a, glm::min(b, c)) and hi = glm::max(a, glm::max(b, c)), four components at
@@ -74,6 +79,8 @@ struct VertexValues {
         const Four low = min_yz < x ? min_yz : x, high = x < max_yz ? max_yz : x;
         std::memcpy(&lo, &low, sizeof lo);
         std::memcpy(&hi, &high, sizeof hi);
+        const auto same = (x == y) & (y == z) & (x != 0.0f) & (x - x == 0.0f);  // (x − x: NaN for ±inf, NaN)
+        one = same[0] & same[1] & same[2] & same[3];
     }
 
     /// Σ w_i·v_i, clamped to the vertex values' range so rounding never leaves it: per component,
