@@ -188,19 +188,13 @@ template <bool kInside>
         _mm_and_si128(_mm_set1_epi32(static_cast<std::int32_t>(bits)), _mm_setr_epi32(1, 2, 4, 8)), _mm_setzero_si128()));
 }
 
-}  // namespace
-
-// AVX2: the same operations on four doubles per register (one group of four pixels each), so the
-// same bits; the depth test and stores are the SSE2 path's.
-[[gnu::target("avx2")]] bool test_sample_row_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], int n,
-                                                  std::uint32_t tested, DepthFunc func, bool depth_write, float* depth,
-                                                  int stride, SampleRow& out) {
-    if (!exact_row(t, e, n)) return false;
-    RowTerms k;
-    splat_row_terms(t, k);
-    __m256d first[3];
-    for (int i = 0; i < 3; ++i) first[i] = _mm256_set1_pd(static_cast<double>(e[i] + t.bias[i]));
-    const bool greater = func == DepthFunc::greater, tests = func != DepthFunc::none;
+// test_sample_row_avx2's loop over the row's pixels, four at a time (kTests: a depth test, less
+// or greater; without one, every covered pixel asked for passes and depth is left alone).
+template <bool kTests>
+[[gnu::always_inline]] [[gnu::target("avx2")]] inline void sample_row(const RowTerms& k, const __m256d (&first)[3],
+                                                                     int n, std::uint32_t tested, bool greater,
+                                                                     bool depth_write, float* depth, int stride,
+                                                                     SampleRow& out) {
     out.covered = out.passed = 0;
     // Pixel indices j … j + 3 (small integers: stepping them by 4 is exact; built from j each
     // time, the conversions were a chain the loop waited on).
@@ -214,20 +208,41 @@ template <bool kInside>
         out.covered |= covered << j;
         const std::uint32_t asked = covered & (tested >> j);
         if (!asked) continue;
-        float* const stored = tests ? depth + j * stride : nullptr;
-        const __m128 s = tests ? stored_depths(stored, stride, lanes) : _mm_setzero_ps();
-        const std::uint32_t passed =
-            tests ? static_cast<std::uint32_t>(_mm_movemask_ps(greater ? _mm_cmpgt_ps(p.depths, s)
-                                                                       : _mm_cmplt_ps(p.depths, s))) &
-                        asked
-                  : asked;
-        if (!passed) continue;
+        std::uint32_t passed = asked;
+        float* stored = nullptr;
+        __m128 s = _mm_setzero_ps();
+        if constexpr (kTests) {
+            stored = depth + j * stride;
+            s = stored_depths(stored, stride, lanes);
+            passed &= static_cast<std::uint32_t>(
+                _mm_movemask_ps(greater ? _mm_cmpgt_ps(p.depths, s) : _mm_cmplt_ps(p.depths, s)));
+            if (!passed) continue;
+        }
         out.passed |= passed << j;
         _mm256_storeu_pd(out.l0 + j, p.l0);
         _mm256_storeu_pd(out.l1 + j, p.l1);
         _mm256_storeu_pd(out.l2 + j, p.l2);
-        if (tests && depth_write) store_depths(stored, stride, lanes, passed, lane_mask(passed), p.depths, s);
+        if (kTests && depth_write) store_depths(stored, stride, lanes, passed, lane_mask(passed), p.depths, s);
     }
+}
+
+}  // namespace
+
+// AVX2: the same operations on four doubles per register (one group of four pixels each), so the
+// same bits; the depth test and stores are the SSE2 path's.
+[[gnu::target("avx2")]] bool test_sample_row_avx2(const SetupTriangle& t, const std::int64_t (&e)[3], int n,
+                                                  std::uint32_t tested, DepthFunc func, bool depth_write, float* depth,
+                                                  int stride, SampleRow& out) {
+    if (!exact_row(t, e, n)) return false;
+    RowTerms k;
+    splat_row_terms(t, k);
+    __m256d first[3];
+    for (int i = 0; i < 3; ++i) first[i] = _mm256_set1_pd(static_cast<double>(e[i] + t.bias[i]));
+    const bool greater = func == DepthFunc::greater;
+    if (func == DepthFunc::none)
+        sample_row<false>(k, first, n, tested, greater, depth_write, depth, stride, out);
+    else
+        sample_row<true>(k, first, n, tested, greater, depth_write, depth, stride, out);
     return true;
 }
 
