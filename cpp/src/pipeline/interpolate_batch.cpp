@@ -1,6 +1,5 @@
 #include "interpolate_batch.hpp"
 
-#include <cmath>
 #include <cstring>
 
 namespace mipraster {

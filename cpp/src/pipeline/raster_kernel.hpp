@@ -51,7 +51,7 @@ inline void shade_into(LookupQueue<kBlend, kShading, kTexturing>* queue, float* 
 // at a time (interpolate_colours), and a triangle of one colour takes it without the sums. (Constant
 // and flat colours cost nothing to shade.)
 template <Shading kShading, Texturing kTexturing>
-inline constexpr bool kColoursByRow =
+inline constexpr bool kInterpolatedColours =
     kTexturing == Texturing::none && (kShading == Shading::screen || kShading == Shading::perspective);
 
 // Shades and blends pixels `passed` of a row of unclipped triangle t (bit j: screen weights l0[j],
@@ -372,7 +372,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         // Untextured screen or perspective shading of three equal vertex colours (VertexValues::one):
         // every sample's colour is flat's, the same bits, without its weights and sums.
         std::optional<glm::vec4> one_colour;
-        if constexpr (kColoursByRow<kShading, kTexturing>)
+        if constexpr (kInterpolatedColours<kShading, kTexturing>)
             if (t.clip_index < 0 && colors.one)
                 one_colour = untextured_colour<Shading::flat>(draw, colors, t, glm::dvec3(0.0), batch.clip_weights);
         TriangleUvs uvs;
@@ -841,7 +841,7 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
     OwnerRef ref{};
     VertexValues colors{};
     TriangleUvs uvs{};
-    Shading run_shading = kShading;  // batch_shading of colors, for untextured runs (kColoursByRow)
+    Shading run_shading = kShading;  // batch_shading of colors, for untextured runs (kInterpolatedColours)
     std::optional<LookupQueue<BlendMode::replace, kShading, kTexturing>> queue;
     if (queues_lookups<kTexturing>(draw)) queue.emplace(draw);
     // The texels of an owner's part of the tile, prefetched the first time it becomes current
@@ -865,7 +865,7 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
         const glm::uvec3 tri = draw.triangles[ref.triangle->triangle];
         if constexpr (kShading == Shading::flat || kShading == Shading::screen || kShading == Shading::perspective)
             colors = VertexValues(draw.vertex_colors[tri[0]], draw.vertex_colors[tri[1]], draw.vertex_colors[tri[2]]);
-        if constexpr (kColoursByRow<kShading, kTexturing>) run_shading = batch_shading(kShading, colors);
+        if constexpr (kInterpolatedColours<kShading, kTexturing>) run_shading = batch_shading(kShading, colors);
         if constexpr (kTexturing != Texturing::none) {
             uvs = TriangleUvs(*ref.triangle, tri, draw.uvs, ref.clip_weights);
             if (queue) {
@@ -920,7 +920,7 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
                     if (queue) {  // the run as one mask
                         counters.shader_invocations += static_cast<std::uint64_t>(n);
                         queue->push_row(first, 4 * S, run, l0, l1, l2, px, py);
-                    } else if (kColoursByRow<kShading, kTexturing> && ref.triangle->clip_index < 0) {
+                    } else if (kInterpolatedColours<kShading, kTexturing> && ref.triangle->clip_index < 0) {
                         counters.shader_invocations += static_cast<std::uint64_t>(n);
                         shade_row_colours<BlendMode::replace>(first, 4 * S, run, l0, l1, l2, draw, run_shading, colors,
                                                               *ref.triangle);
