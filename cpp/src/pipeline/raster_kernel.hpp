@@ -760,8 +760,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             if constexpr (kMode == SampleMode::msaa &&
                           (kTexturing != Texturing::none || kShading == Shading::visibility)) {
                 const bool takes_rows = kShading == Shading::visibility ? target.owners != nullptr : queue.has_value();
-                const bool row_vectors = kDepth == DepthFunc::none ? vector_masks : pixel_vectors;
-                if (takes_rows && row_vectors && n >= kSampleRowMinPixels &&
+                if (takes_rows && vector_masks && n >= kSampleRowMinPixels &&
                     !blocks.row_pixels(classified, py, rx0, n) && sample_rows_exact(t, {row0, row1, row2}, n)) {
                     msaa_row(rx0, py, n, {row0, row1, row2});
                     continue;
