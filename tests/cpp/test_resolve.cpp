@@ -148,6 +148,43 @@ TEST(Resolve, OneSampleResolveCopiesEveryBit) {
             }
 }
 
+// resolve_undrawn is fill_undrawn followed by resolve_tile's box, in one pass: the same bits for
+// every pixel (random colours, random depths of which a random share is the clear depth; pixels
+// with no, some and all samples undrawn; a window with its own origin and pitch), nothing written
+// outside the rectangle, and the samples themselves left as they were. The clear colour holds a
+// −0 and a subnormal, which the mean keeps.
+TEST(Resolve, ResolvingOverUndrawnSamplesIsTheFillThenTheResolve) {
+    std::mt19937_64 rng(46);
+    std::uniform_real_distribution<float> u(-1.0f, 2.0f);
+    const glm::vec4 clear(0.25f, -0.0f, 1e-40f, 1.0f);
+    const float clear_depth = 1.0f;
+    const int x0 = 5, y0 = 2, x1 = 16, y1 = 9, pitch = 13, W = 19, H = 11;
+    for (int S : {1, 2, 3, 4, 8, 9, 16, 64}) {
+        for (double undrawn_share : {0.0, 0.3, 0.9, 1.0}) {
+            SCOPED_TRACE("S=" + std::to_string(S) + ", undrawn share " + std::to_string(undrawn_share));
+            std::bernoulli_distribution undrawn(undrawn_share);
+            const std::size_t count = static_cast<std::size_t>(pitch) * (y1 - y0) * S;
+            std::vector<float> colour(4 * count), depth(count);
+            for (float& v : colour) v = u(rng);
+            for (std::size_t i = 0; i < count; ++i) {
+                // Whole pixels undrawn or drawn as well as single samples.
+                const std::size_t pixel = i / static_cast<std::size_t>(S);
+                const bool whole = pixel % 3 == 0, pixel_undrawn = pixel % 6 == 0;
+                depth[i] = (whole ? pixel_undrawn : undrawn(rng)) ? clear_depth : std::nextafter(clear_depth, 0.0f) * u(rng);
+            }
+            const mr::SampleWindow c{colour.data(), 4, x0, y0, pitch, S}, z{depth.data(), 1, x0, y0, pitch, S};
+            const std::vector<float> colour_before = colour;
+            mr::Image fused(W, H, 4);
+            mr::resolve_undrawn(c, z, x0, y0, x1, y1, clear_depth, clear, fused);
+            EXPECT_TRUE(same_bits(colour, colour_before)) << "the samples changed";
+            mr::fill_undrawn(c, z, x0, y0, x1, y1, clear_depth, clear);
+            mr::Image two_passes(W, H, 4);
+            mr::resolve_tile(c, x0, y0, x1, y1, mr::ResolveFilter::box, two_passes);
+            EXPECT_TRUE(same_bits(fused.pixels, two_passes.pixels));
+        }
+    }
+}
+
 // The mean of finite samples is finite, however large they are: the sum must not overflow.
 TEST(Resolve, SamplesNearTheFloatMaximumResolveToTheirFiniteMean) {
     const float big = std::numeric_limits<float>::max();

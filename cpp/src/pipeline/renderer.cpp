@@ -666,6 +666,11 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
         needs_depth && !whole_frame && std::all_of(draws.begin(), draws.end(), [](const Draw& d) {
             return d.state.depth_test && d.state.depth_write && d.state.blend == BlendMode::replace;
         });
+    // With several samples a pixel, the undrawn samples' clear colour can go straight into the
+    // resolve where nothing else reads the tile's colour samples (the error estimate does): the
+    // background is then neither stored nor read back (MSAA 4x: 128 bytes a pixel). (At one
+    // sample the resolve is a copy, faster than that pass's depth test per pixel.)
+    const bool resolve_over_clear = lazy_colour_clear && !settings.estimate_error && S > 1;
     Framebuffer kept;
     if (whole_frame)
         kept = make_framebuffer(settings.width, settings.height, S, settings.clear_color, needs_depth, clear_depth);
@@ -765,7 +770,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                                         msaa, counters);
             else
                 rasterize_tile_chunks(tile, chunks, kernels, inputs, target, counters);
-            if (lazy_colour_clear)
+            if (lazy_colour_clear && !resolve_over_clear)
                 fill_undrawn(target.color, target.depth, target.x0, target.y0, target.x1, target.y1, clear_depth,
                              settings.clear_color);
         }
@@ -779,7 +784,10 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
                 }
                 rasterize_tile_chunks(tile, chunks, kernels, inputs, part, counters);
             }
-            if (!wide_resolve)  // (the box: at one sample every filter's resolve is this copy)
+            if (resolve_over_clear && rasterize_whole)
+                resolve_undrawn(part.color, part.depth, part.x0, part.y0, part.x1, part.y1, clear_depth,
+                                settings.clear_color, result.color);
+            else if (!wide_resolve)  // (the box: at one sample every filter's resolve is this copy)
                 resolve_tile(part.color, part.x0, part.y0, part.x1, part.y1, ResolveFilter::box, result.color);
             if (settings.estimate_error)
                 estimate_tile_error(part.color, halves, part.x0, part.y0, part.x1, part.y1, result.error_map);

@@ -65,12 +65,17 @@ inline RgbaDouble widen(const float* p) {
 // though their mean is finite (all four channels in one vector: per channel the same additions,
 // from +0, in order). A power-of-two count divides by multiplying with its exact reciprocal
 // (kPowerOfTwo; the same bits): four double divisions a pixel were most of the resolve.
-template <int kSamples, bool kPowerOfTwo>
-inline Rgba sample_mean(const float* p, int S, double inverse) {
+// `sample(p, s)`: where sample s's RGBA is (p + 4s, or another colour in its place).
+template <int kSamples, bool kPowerOfTwo, typename Sample>
+inline Rgba sample_mean(const float* p, int S, double inverse, Sample&& sample) {
     const int count = kSamples ? kSamples : S;
     RgbaDouble sum{0, 0, 0, 0};
-    for (int s = 0; s < count; ++s) sum += widen(p + 4 * s);
+    for (int s = 0; s < count; ++s) sum += widen(sample(p, s));
     return __builtin_convertvector(kPowerOfTwo ? sum * inverse : sum / double(count), Rgba);
+}
+template <int kSamples, bool kPowerOfTwo>
+inline Rgba sample_mean(const float* p, int S, double inverse) {
+    return sample_mean<kSamples, kPowerOfTwo>(p, S, inverse, [](const float* q, int s) { return q + 4 * s; });
 }
 
 // Orders the streaming stores before whatever the thread stores next (the pool's hand-off).
@@ -109,6 +114,59 @@ void resolve_tile(const SampleWindow& samples, int x0, int y0, int x1, int y1, R
         each_row([S, inverse](const float* p) { return sample_mean<0, false>(p, S, inverse); });
     }
     finish_rows();
+}
+
+namespace {
+
+// resolve_undrawn for a count of S samples (kSamples: S known when compiling, else 0).
+template <int kSamples, bool kPowerOfTwo>
+void resolve_undrawn_rows(const SampleWindow& samples, const SampleWindow& depth, int x0, int y0, int x1, int y1,
+                          float clear_depth, const float* clear, Image& out) {
+    const int S = kSamples ? kSamples : samples.samples;
+    const double inverse = 1.0 / S;
+    // A pixel none of whose samples was drawn: what resolve_tile makes of S clear samples.
+    const Rgba clear_pixel = sample_mean<kSamples, kPowerOfTwo>(nullptr, S, inverse,
+                                                                [clear](const float*, int) { return clear; });
+    for (int y = y0; y < y1; ++y) {
+        const float* const colour = samples.at(x0, y, 0);
+        const float* const z = depth.at(x0, y, 0);
+        write_row(&out.at(x0, y, 0), x1 - x0, [&](int i) {
+            const float* const pixel_z = z + std::ptrdiff_t{S} * i;
+            int undrawn = 0, all = S;  // (a count, or with SSE2 at four samples a mask)
+#if defined(__SSE2__)
+            if constexpr (kSamples == 4) {  // (the four depths in one compare)
+                undrawn = _mm_movemask_ps(_mm_cmpeq_ps(_mm_loadu_ps(pixel_z), _mm_set1_ps(clear_depth)));
+                all = 0xF;
+            } else
+#endif
+            {
+                for (int s = 0; s < S; ++s) undrawn += pixel_z[s] == clear_depth;
+            }
+            const float* const p = colour + std::ptrdiff_t{4} * S * i;
+            if constexpr (kSamples == 1) {  // (resolve_tile's copy: every bit)
+                Rgba v;
+                std::memcpy(&v, undrawn ? clear : p, sizeof v);
+                return v;
+            }
+            if (undrawn == 0) return sample_mean<kSamples, kPowerOfTwo>(p, S, inverse);
+            if (undrawn == all) return clear_pixel;
+            return sample_mean<kSamples, kPowerOfTwo>(p, S, inverse, [&](const float* q, int s) {
+                return pixel_z[s] == clear_depth ? clear : q + 4 * s;  // its colour, or the clear one
+            });
+        });
+    }
+    finish_rows();
+}
+
+}  // namespace
+
+void resolve_undrawn(const SampleWindow& samples, const SampleWindow& depth, int x0, int y0, int x1, int y1,
+                     float clear_depth, const glm::vec4& clear, Image& out) {
+    const int S = samples.samples;
+    if (S == 1) resolve_undrawn_rows<1, true>(samples, depth, x0, y0, x1, y1, clear_depth, &clear.x, out);
+    else if (S == 4) resolve_undrawn_rows<4, true>(samples, depth, x0, y0, x1, y1, clear_depth, &clear.x, out);
+    else if ((S & (S - 1)) == 0) resolve_undrawn_rows<0, true>(samples, depth, x0, y0, x1, y1, clear_depth, &clear.x, out);
+    else resolve_undrawn_rows<0, false>(samples, depth, x0, y0, x1, y1, clear_depth, &clear.x, out);
 }
 
 void write_pixels(const glm::vec4& value, int x0, int y0, int x1, int y1, Image& out) {

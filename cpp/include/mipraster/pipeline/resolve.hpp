@@ -25,6 +25,12 @@ ResolveFilter parse_resolve_filter(const std::string& name);
 /// Only the box filter is pixel-local: another filter throws std::invalid_argument.
 void resolve_tile(const SampleWindow& samples, int x0, int y0, int x1, int y1, ResolveFilter filter, Image& out);
 
+/// fill_undrawn (framebuffer.hpp) and then resolve_tile's box, in one pass: each sample whose
+/// depth is still `clear_depth` counts as `clear` (the same bits), and `samples` is left as it is.
+/// A pixel none of whose samples was drawn reads no colour. `depth` has the window's layout.
+void resolve_undrawn(const SampleWindow& samples, const SampleWindow& depth, int x0, int y0, int x1, int y1,
+                     float clear_depth, const glm::vec4& clear, Image& out);
+
 /// Writes `value` to the pixels [x0, x1) × [y0, y1) of `out` (H, W, 4) the way resolve_tile writes
 /// its pixels (past the cache where it can): a tile with nothing drawn on it.
 void write_pixels(const glm::vec4& value, int x0, int y0, int x1, int y1, Image& out);
