@@ -669,7 +669,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     // With several samples a pixel, the undrawn samples' clear colour can go straight into the
     // resolve where nothing else reads the tile's colour samples (the error estimate does): the
     // background is then neither stored nor read back (MSAA 4x: 128 bytes a pixel). (At one
-    // sample the resolve is a copy, faster than that pass's depth test per pixel.)
+    // sample, where the resolve is a copy, the pass measured no faster than fill_undrawn + copy.)
     const bool resolve_over_clear = lazy_colour_clear && !settings.estimate_error && S > 1;
     Framebuffer kept;
     if (whole_frame)
