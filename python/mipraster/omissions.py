@@ -248,7 +248,7 @@ OMISSIONS = [
              "exact"),
     Omission("no colour clear before drawing where every sample is drawn", "colour grid, MSAA 4x",
              Variant("every draw tests and writes depth and replaces colour: the samples still at the clear "
-                     "depth are cleared after drawing", with_options(colour_grid(), spp=4, aa="msaa")),
+                     "depth count as the clear colour in the resolve", with_options(colour_grid(), spp=4, aa="msaa")),
              Variant("+ one off-screen triangle blending add: each tile's colour cleared before drawing",
                      with_options(with_no_op_draw(colour_grid()), spp=4, aa="msaa")), "exact"),
     Omission("lazily built mip levels", "full-screen quad magnifying a fresh 1024² texture",
