@@ -738,8 +738,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                         }
                         const SampleRow& row = fours ? four[s % 4] : single_row;
                         counters.samples_covered += static_cast<std::uint64_t>(count_bits(row.covered & ~skipped));
-                        if constexpr (kShading == Shading::visibility || kTexturing != Texturing::none)
-                            if (passed_row(rx0, py, s, row)) continue;
+                        if (passed_row(rx0, py, s, row)) continue;
                         blocks.written_row(py, rx0, row.passed);
                         for (std::uint32_t m = row.passed; m; m &= m - 1) {
                             const int j = __builtin_ctz(m);
