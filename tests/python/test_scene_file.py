@@ -994,6 +994,69 @@ def test_gltf_morph_targets_at_the_node_or_mesh_default_weights(tmp_path):
         mr.load_scene(bad)
 
 
+def test_gltf_morph_targets_move_texcoords_and_colours_as_the_spec_says(tmp_path):
+    # TEXCOORD_n and COLOR_n deltas (the spec's optional morphs) add up as POSITION's: uv = base +
+    # Σ w·Δ before the texture transform maps it; colour = clamp(base + Σ w·Δ, 0, 1) (a VEC3 delta
+    # leaves alpha), then premultiplied where the material blends (mesh 0; mesh 1's plain material
+    # has no texture to transform for). Deltas in float and normalized byte/short; a negative
+    # weight; the numpy sums below are the oracle.
+    write_texture(tmp_path / "checker.png")
+    rng = np.random.default_rng(47)
+    uvs = rng.uniform(0, 1, (3, 2)).astype(np.float32)
+    colours = np.float32([[0.2, 0.9, 0.5, 0.8], [0.95, 0.1, 0.4, 0.3], [0.5, 0.5, 0.05, 1.0]])
+    duv0 = rng.uniform(-0.5, 0.5, (3, 2)).astype(np.float32)
+    duv1 = rng.integers(-127, 128, (3, 2)).astype(np.int8)  # normalized: /127
+    dcol0 = np.float32([[0.5, -0.4, 0.1], [0.2, 0.3, -0.9], [-0.1, 0.0, 0.6]])  # VEC3: alpha unmoved
+    dcol1 = rng.integers(-32767, 32768, (3, 4)).astype(np.int16)  # normalized: /32767
+    chunks = [TRIANGLE.tobytes(), uvs.tobytes(), colours.tobytes(), duv0.tobytes(), duv1.tobytes(),
+              dcol0.tobytes(), dcol1.tobytes()]
+    accessors = [vec_accessor(0, 3, min=[-0.5, -0.5, 0], max=[0.5, 0.5, 0]), vec_accessor(1, 3, "VEC2"),
+                 vec_accessor(2, 3, "VEC4"), vec_accessor(3, 3, "VEC2"),
+                 vec_accessor(4, 3, "VEC2", 5120, normalized=True), vec_accessor(5, 3, "VEC3"),
+                 vec_accessor(6, 3, "VEC4", 5122, normalized=True)]
+    targets = [{"TEXCOORD_0": 3, "COLOR_0": 5}, {"TEXCOORD_0": 4, "COLOR_0": 6}]
+    transform = {"offset": [0.25, -0.5], "rotation": 0.3, "scale": [2.0, 0.5]}
+    texture = {"index": 0, "extensions": {"KHR_texture_transform": transform}}
+    materials = [{"alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorTexture": texture}}, {}]
+    meshes = [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "COLOR_0": 2}, "targets": targets,
+                               "material": m}]} for m in (0, 1)]
+    weights = [(0.75, -0.5), (1.0, 0.0), (0.0, 0.0)]
+    nodes = [{"mesh": 0, "weights": list(weights[0])}, {"mesh": 0, "weights": list(weights[1])},
+             {"mesh": 0, "weights": list(weights[2])}, {"mesh": 1, "weights": list(weights[0])}]
+    path = write_mesh_gltf(tmp_path / "morph_uv_colour.gltf", chunks, accessors, None, materials, meshes=meshes,
+                           nodes=nodes, extra={"textures": [{"source": 0}], "images": [{"uri": "checker.png"}],
+                                               "extensionsUsed": ["KHR_texture_transform"]})
+    scene, _ = mr.load_scene(path)
+    assert len(scene.draws) == 4
+    steps1 = np.maximum(duv1 / 127.0, -1.0), np.maximum(dcol1 / 32767.0, -1.0)
+    for draw, (w0, w1), blends in zip(scene.draws, weights + [weights[0]], [True, True, True, False]):
+        want_uv = uvs.astype(np.float64) + w0 * duv0 + w1 * steps1[0]
+        want_uv = spec_uv_transform(want_uv, **transform) if blends else want_uv
+        np.testing.assert_allclose(draw.mesh.uvs, want_uv, rtol=0, atol=1e-6, err_msg=str((w0, w1)))
+        moved = colours.astype(np.float64) + w0 * np.hstack([dcol0, np.zeros((3, 1))]) + w1 * steps1[1]
+        moved = np.clip(moved, 0.0, 1.0) if (w0, w1) != (0.0, 0.0) else moved
+        alpha = moved[:, 3:] if blends else np.ones((3, 1))
+        want_colour = np.hstack([moved[:, :3] * alpha, alpha])
+        np.testing.assert_allclose(draw.mesh.colors, want_colour, rtol=0, atol=1e-7, err_msg=str((w0, w1, blends)))
+    assert (np.asarray(scene.draws[0].mesh.colors) == 0).any()  # the clamp acted (below 0)
+    assert (np.asarray(scene.draws[1].mesh.colors)[:, :3] == np.asarray(scene.draws[1].mesh.colors)[:, 3:]).any()
+
+    # A delta accessor of the wrong type or component type is an error naming it.
+    for k, (accessor, message) in enumerate([(vec_accessor(5, 3, "VEC2"), r"COLOR_0 must be VEC3 or VEC4"),
+                                             (vec_accessor(5, 3, "VEC3"), r"TEXCOORD_0 must be VEC2"),
+                                             (vec_accessor(4, 3, "VEC2", 5120), r"TEXCOORD_0 deltas must be float "
+                                              r"or normalized byte/short, got component type 5120")]):
+        bad_accessors = accessors + [accessor]
+        bad_targets = [{"TEXCOORD_0": 3, "COLOR_0": 5}, dict(targets[1])]
+        bad_targets[1]["COLOR_0" if "COLOR" in message else "TEXCOORD_0"] = len(accessors)
+        bad_meshes = [{"primitives": [{**meshes[0]["primitives"][0], "targets": bad_targets}]}]
+        bad = write_mesh_gltf(tmp_path / f"bad{k}.gltf", chunks, bad_accessors, None, materials, meshes=bad_meshes,
+                              nodes=[{"mesh": 0, "weights": [0.5, 0.5]}],
+                              extra={"textures": [{"source": 0}], "images": [{"uri": "checker.png"}]})
+        with pytest.raises(OSError, match=rf"bad{k}\.gltf: .*targets\[1\] .*\(accessor 7\): " + message):
+            mr.load_scene(bad)
+
+
 def trs(translation=(0, 0, 0), rotation=(0, 0, 0, 1), scale=(1, 1, 1)):
     """glTF's T · R · S of a node (rotation a unit quaternion x, y, z, w), as numpy does it."""
     x, y, z, w = rotation

@@ -26,6 +26,7 @@
 #include <utility>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
@@ -741,6 +742,15 @@ struct GltfLoader {
                              type == TINYGLTF_COMPONENT_TYPE_SHORT);
     }
 
+    /// Morph target deltas of TEXCOORD_n and COLOR_n: float, or normalized (un)signed byte/short
+    /// (and with KHR_mesh_quantization, texture coordinate deltas as plain byte/short too).
+    bool delta_type_allowed(int type, bool normalized) const {
+        const bool small_integer = type == TINYGLTF_COMPONENT_TYPE_BYTE || type == TINYGLTF_COMPONENT_TYPE_SHORT ||
+                                   type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                   type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+        return type == TINYGLTF_COMPONENT_TYPE_FLOAT || (small_integer && (normalized || quantized));
+    }
+
     /// Float, or normalized unsigned byte/short: glTF 2.0's types for colours, weights and uvs.
     static bool float_or_unit_unsigned(int type, bool normalized) {
         return type == TINYGLTF_COMPONENT_TYPE_FLOAT ||
@@ -770,19 +780,32 @@ struct GltfLoader {
         return std::all_of(w.begin(), w.end(), [](double x) { return x == 0.0; }) ? std::vector<double>{} : w;
     }
 
-    /// Adds each morph target's POSITION displacements times its weight (normals and tangents,
-    /// the other standard targets, do not change an unlit render).
-    void morph(const tinygltf::Primitive& prim, const std::vector<double>& weights, std::vector<glm::dvec3>& positions,
-               const std::string& what) {
+    /// Adds each morph target's `name` deltas times its weight to `values` (one per vertex):
+    /// POSITION (VEC3), TEXCOORD_n (VEC2) and COLOR_n (VEC4, or VEC3 with an alpha delta of 0) —
+    /// normals and tangents, the other standard targets, do not change an unlit render. True when
+    /// some delta was added.
+    template <int N>
+    bool morph(const tinygltf::Primitive& prim, const std::vector<double>& weights, const std::string& name,
+               std::vector<glm::vec<N, double>>& values, const std::string& what) {
+        const bool colour = name.rfind("COLOR_", 0) == 0;
+        bool added = false;
         for (std::size_t t = 0; t < weights.size() && t < prim.targets.size(); ++t) {
-            const auto it = prim.targets[t].find("POSITION");
+            const auto it = prim.targets[t].find(name);
             if (weights[t] == 0.0 || it == prim.targets[t].end()) continue;
-            const AccessorReader d(model, it->second, path, what + " targets[" + std::to_string(t) + "] POSITION");
-            if (d.components() != 3) fail(path, d.what() + ": POSITION must be VEC3");
-            check_per_vertex(d, "the target's POSITION", positions.size());
-            for (std::size_t i = 0; i < positions.size(); ++i)
-                positions[i] += weights[t] * glm::dvec3(d.get(i, 0), d.get(i, 1), d.get(i, 2));
+            const AccessorReader d(model, it->second, path, what + " targets[" + std::to_string(t) + "] " + name);
+            const int width = d.components();
+            if (width != N && !(colour && width == 3))
+                fail(path,
+                     d.what() + ": " + name + " must be " + (colour ? "VEC3 or VEC4" : "VEC" + std::to_string(N)));
+            if (name != "POSITION" && !delta_type_allowed(d.component_type(), d.normalized()))
+                fail(path, d.what() + ": " + name + " deltas must be float or normalized byte/short, got component " +
+                               "type " + std::to_string(d.component_type()));
+            check_per_vertex(d, "the target's " + name, values.size());
+            for (std::size_t i = 0; i < values.size(); ++i)
+                for (int c = 0; c < width; ++c) values[i][c] += weights[t] * d.get(i, c);
+            added = true;
         }
+        return added;
     }
 
     /// A node's matrix in the scene: its ancestors' matrices times its own (nodes have one parent).
@@ -863,8 +886,8 @@ struct GltfLoader {
         positions = std::move(skinned);
     }
 
-    /// The mesh of a primitive, its positions moved by its morph targets at `weights` (morph_weights)
-    /// and, when `skin` is not −1, by that skin's `joints` (joint_matrices).
+    /// The mesh of a primitive, its positions, uvs and colours moved by its morph targets at `weights`
+    /// (morph_weights) and its positions, when `skin` is not −1, by that skin's `joints` (joint_matrices).
     std::shared_ptr<Mesh> primitive_mesh(int mesh_index, int prim_index, const std::vector<double>& weights, int skin,
                                          const std::vector<glm::dmat4>& joints) {
         const auto key = std::make_tuple(mesh_index, prim_index, weights, skin);
@@ -882,7 +905,7 @@ struct GltfLoader {
         std::vector<glm::dvec3> positions(pos.count());
         for (std::size_t i = 0; i < pos.count(); ++i)
             positions[i] = glm::dvec3(pos.get(i, 0), pos.get(i, 1), pos.get(i, 2));
-        morph(prim, weights, positions, what);
+        morph(prim, weights, "POSITION", positions, what);
         if (skin >= 0) apply_skin(prim, joints, positions, what);
         mesh->positions.resize(pos.count());
         for (std::size_t i = 0; i < pos.count(); ++i) mesh->positions[i] = glm::vec3(positions[i]);
@@ -896,11 +919,19 @@ struct GltfLoader {
             if (!float_or_unit_unsigned(col.component_type(), col.normalized()))
                 fail(path, col.what() + ": COLOR_0 must be float or normalized unsigned byte/short");
             check_per_vertex(col, "COLOR_0", pos.count());
+            // Morphed (the spec's COLOR_n deltas, then a clamp to [0, 1]) before premultiplying.
+            std::vector<glm::dvec4> colours(col.count());
+            for (std::size_t i = 0; i < col.count(); ++i)
+                colours[i] = glm::dvec4(col.get(i, 0), col.get(i, 1), col.get(i, 2),
+                                        col.components() == 4 ? col.get(i, 3) : 1.0);
+            if (morph(prim, weights, "COLOR_0", colours, what))
+                for (glm::dvec4& c : colours) c = glm::clamp(c, 0.0, 1.0);
             const bool alpha = material_uses_alpha(prim.material);
             mesh->colors.resize(col.count());
             for (std::size_t i = 0; i < col.count(); ++i) {
-                const double a = col.components() == 4 && alpha ? col.get(i, 3) : 1.0;
-                mesh->colors[i] = glm::vec4(col.get(i, 0) * a, col.get(i, 1) * a, col.get(i, 2) * a, a);
+                const glm::dvec4& c = colours[i];
+                const double a = alpha ? c.a : 1.0;
+                mesh->colors[i] = glm::vec4(c.r * a, c.g * a, c.b * a, a);
             }
         }
 
@@ -922,11 +953,12 @@ struct GltfLoader {
                                           : "") +
                                ", got component type " + std::to_string(ct) + (uv.normalized() ? " (normalized)" : ""));
             check_per_vertex(uv, uv_name, pos.count());
+            std::vector<glm::dvec2> values(uv.count());
+            for (std::size_t i = 0; i < uv.count(); ++i) values[i] = glm::dvec2(uv.get(i, 0), uv.get(i, 1));
+            morph(prim, weights, uv_name, values, what);  // (before the texture transform, which maps the result)
             mesh->uvs.resize(uv.count());
-            for (std::size_t i = 0; i < uv.count(); ++i) {
-                const glm::dvec2 value(uv.get(i, 0), uv.get(i, 1));
-                mesh->uvs[i] = choice.transformed ? choice.apply(value) : glm::vec2(value);
-            }
+            for (std::size_t i = 0; i < uv.count(); ++i)
+                mesh->uvs[i] = choice.transformed ? choice.apply(values[i]) : glm::vec2(values[i]);
         }
 
         // Normals: float (or normalized signed byte/short, as KHR_mesh_quantization allows).
