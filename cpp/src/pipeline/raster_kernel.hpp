@@ -571,6 +571,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         const auto msaa_row = [&](int rx0, int py, int n, const std::int64_t (&corner)[3]) {
             std::uint64_t samples[kTileSize];  // per pixel, the samples that passed
             std::uint32_t pixels = 0;
+            std::uint64_t found_passed = 0;  // how many samples passed
             if constexpr (kDepth == DepthFunc::none) {  // (every covered sample passes)
                 pixel_coverage_avx2(corner, {off0, off1, off2}, {step0, step1, step2}, n, S, samples);
                 std::uint64_t covered = 0;
@@ -580,6 +581,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 }
                 counters.samples_covered += covered;
                 counters.samples_passed += covered;
+                found_passed = covered;
                 if (!pixels) return;
             } else {
                 const double* const offsets[3] = {offset0, offset1, offset2};
@@ -587,6 +589,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                                                                depth_out.at(rx0, py, 0), samples);
                 counters.samples_covered += found.covered;
                 counters.samples_passed += found.passed;
+                found_passed = found.passed;
                 pixels = found.pixels;
                 if (!pixels) return;
                 blocks.written_row(py, rx0, pixels);
@@ -594,6 +597,16 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             const std::int64_t centre[3] = {corner[0] + to_centre0, corner[1] + to_centre1, corner[2] + to_centre2};
             const std::uint32_t centres = row_coverage_avx2(centre, {step0, step1, step2}, n);  // bit j: inside
             if constexpr (kShading == Shading::visibility) {
+                // A row won whole, every pixel at its centre (most rows of a large triangle): its
+                // owners and places are one run each (pixel by pixel, 28 instructions a pixel).
+                const std::uint32_t row = ~std::uint32_t{0} >> (32 - n);
+                if (centres == row && found_passed == static_cast<std::uint64_t>(n) * S) {
+                    const std::size_t first = target.owner_index(rx0, py, 0, S);
+                    const auto count = static_cast<std::size_t>(S) * static_cast<std::size_t>(n);
+                    std::fill_n(target.owners + first, count, owner);
+                    std::memset(target.owner_shade_at + first, kShadeAtCentre, count);
+                    return;
+                }
                 for (std::uint32_t m = pixels; m; m &= m - 1) {
                     const int j = __builtin_ctz(m);
                     record_owner(rx0 + j, py, samples[j], centres >> j & 1);
