@@ -970,7 +970,8 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
         // Runs of pixels whose samples all have one owner that shades them at their centres go to
         // the lookup queue a row at a time, their weights as the forward kernel's long rows take them.
         // Such a run from pixel px on ends where a sample's owner or place differs: a scan of the
-        // row's samples, four at a time (a sample at a time, this scan was two thirds of the pass).
+        // row's samples, 32 at a time, then four (a sample at a time, this scan was two thirds of
+        // the pass; four at a time, 19 instructions a pixel).
         const auto centre_run_end = [&](int px, int py, std::int32_t owner) {
             const std::size_t first = target.owner_index(px, py, 0, S);
             const std::size_t count = static_cast<std::size_t>(target.x1 - px) * static_cast<std::size_t>(S);
@@ -978,6 +979,12 @@ void shade_owned(const TileTarget& target, const DrawInputs& draw, std::uint32_t
             const std::uint8_t* const places = target.owner_shade_at + first;
             static_assert(kShadeAtCentre == 0xff, "four places at the centre are an all-ones word");
             std::size_t k = 0;
+            for (; k + 32 <= count; k += 32) {  // (branch-free within: the compiler vectorizes it)
+                std::uint32_t differ = 0;
+                for (std::size_t q = k; q < k + 32; ++q)
+                    differ |= static_cast<std::uint32_t>(owners[q] ^ owner) | static_cast<std::uint8_t>(places[q] + 1);
+                if (differ) break;
+            }
             for (; k + 4 <= count; k += 4) {
                 std::uint32_t four_places;
                 std::memcpy(&four_places, places + k, sizeof four_places);
