@@ -984,7 +984,34 @@ struct GltfLoader {
         return mesh;
     }
 
-    void add_node(int index, const glm::dmat4& parent, int depth) {
+    /// Adds the draws and cameras of the hierarchy below root, depth first, each node before its
+    /// children. A walk with its own stack, not a recursion: at the depth limit the recursion's
+    /// frames took 0.8 MB of the thread's stack, 8.5 MB with AddressSanitizer (more than there was).
+    void add_tree(int root) {
+        struct Visit {
+            int index;
+            glm::dmat4 world;
+            int depth;
+            std::size_t next_child;
+        };
+        std::vector<Visit> path_from_root = {{root, add_node(root, glm::dmat4(1.0), 0), 0, 0}};
+        while (!path_from_root.empty()) {
+            Visit& v = path_from_root.back();
+            const std::vector<int>& children = model.nodes[static_cast<std::size_t>(v.index)].children;
+            if (v.next_child == children.size()) {
+                on_path[v.index] = false;
+                path_from_root.pop_back();
+                continue;
+            }
+            const int child = children[v.next_child++], depth = v.depth + 1;
+            const glm::dmat4 world = add_node(child, v.world, depth);
+            path_from_root.push_back({child, world, depth, 0});  // (v is not used past this)
+        }
+    }
+
+    /// Checks node `index` (depth levels below its root), adds its draws and camera and marks it
+    /// on the path from the root (add_tree clears the mark after its children); its world matrix.
+    glm::dmat4 add_node(int index, const glm::dmat4& parent, int depth) {
         if (index < 0 || static_cast<std::size_t>(index) >= model.nodes.size())
             fail(path, "node " + std::to_string(index) + " does not exist (the file has " +
                            std::to_string(model.nodes.size()) + " nodes)");
@@ -1050,9 +1077,7 @@ struct GltfLoader {
                                " does not exist");
             scene.cameras.push_back(make_camera(model.cameras[node.camera], node.camera, world));
         }
-
-        for (int child : node.children) add_node(child, world, depth + 1);
-        on_path[index] = false;
+        return world;
     }
 
     /// The world matrices of a mesh node's EXT_mesh_gpu_instancing instances: world × T·R·S of each
@@ -1327,7 +1352,7 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
         for (std::size_t i = 0; i < model.nodes.size(); ++i)
             if (!is_child[i]) roots.push_back(static_cast<int>(i));
     }
-    for (int r : roots) g.add_node(r, glm::dmat4(1.0), 0);
+    for (int r : roots) g.add_tree(r);
     if (g.skipped_primitives)
         g.scene.warnings.push_back(path + ": skipped " + std::to_string(g.skipped_primitives) +
                                    " primitive(s) of mode POINTS or LINES, or of an unknown mode (only triangles "
