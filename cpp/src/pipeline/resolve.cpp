@@ -163,10 +163,11 @@ void resolve_undrawn_rows(const SampleWindow& samples, const SampleWindow& depth
 void resolve_undrawn(const SampleWindow& samples, const SampleWindow& depth, int x0, int y0, int x1, int y1,
                      float clear_depth, const glm::vec4& clear, Image& out) {
     const int S = samples.samples;
-    if (S == 1) resolve_undrawn_rows<1, true>(samples, depth, x0, y0, x1, y1, clear_depth, &clear.x, out);
-    else if (S == 4) resolve_undrawn_rows<4, true>(samples, depth, x0, y0, x1, y1, clear_depth, &clear.x, out);
-    else if ((S & (S - 1)) == 0) resolve_undrawn_rows<0, true>(samples, depth, x0, y0, x1, y1, clear_depth, &clear.x, out);
-    else resolve_undrawn_rows<0, false>(samples, depth, x0, y0, x1, y1, clear_depth, &clear.x, out);
+    const float* const c = &clear.x;
+    if (S == 1) resolve_undrawn_rows<1, true>(samples, depth, x0, y0, x1, y1, clear_depth, c, out);
+    else if (S == 4) resolve_undrawn_rows<4, true>(samples, depth, x0, y0, x1, y1, clear_depth, c, out);
+    else if ((S & (S - 1)) == 0) resolve_undrawn_rows<0, true>(samples, depth, x0, y0, x1, y1, clear_depth, c, out);
+    else resolve_undrawn_rows<0, false>(samples, depth, x0, y0, x1, y1, clear_depth, c, out);
 }
 
 void write_pixels(const glm::vec4& value, int x0, int y0, int x1, int y1, Image& out) {
