@@ -56,6 +56,7 @@ py::dict stats_dict(const RenderStats& s) {
     d["triangles_in"] = s.triangles_in;
     d["triangles_clipped"] = s.triangles_clipped;
     d["triangles_outside"] = s.triangles_outside;
+    d["triangles_between_samples"] = s.triangles_between_samples;
     d["triangles_backface"] = s.triangles_backface;
     d["triangles_degenerate"] = s.triangles_degenerate;
     d["triangles_nonfinite"] = s.triangles_nonfinite;

@@ -59,7 +59,9 @@ class RenderResult:
             :class:`mipraster.adaptive.AdaptivePass` (each ``"refine"`` or ``"uniform"``, with the
             cost model's prediction for both plans and the measured time), else None.
         stats: dict of the renderer's counters (``triangles_in``, ``triangles_clipped``,
-            ``triangles_outside``, ``triangles_backface``, ``triangles_degenerate``,
+            ``triangles_outside``, ``triangles_between_samples``: in the view, but with no sample
+            position inside its bounding box (left out before binning), ``triangles_backface``,
+            ``triangles_degenerate``,
             ``triangles_nonfinite``, ``triangles_rasterized``, ``samples_covered``,
             ``samples_passed``: of those, the ones that passed the depth test and any alpha test (as an
             OpenGL occlusion query counts), ``shader_invocations``, ``depth_blocks_rejected``, ``tiles_deferred``: tiles

@@ -616,7 +616,8 @@ TEST(Renderer, StatsJsonHoldsEveryCounter) {
     EXPECT_NE(j.find("\"triangles_in\": 7,"), std::string::npos) << j;
     EXPECT_NE(j.find("\"samples_passed\": 123456789012,"), std::string::npos) << j;
     EXPECT_NE(j.find("\"total_ms\": 1.500"), std::string::npos) << j;
-    for (const char* key : {"triangles_clipped", "triangles_outside", "triangles_backface", "triangles_degenerate",
+    for (const char* key : {"triangles_clipped", "triangles_outside", "triangles_between_samples", "triangles_backface",
+                            "triangles_degenerate",
                             "triangles_nonfinite", "triangles_rasterized", "samples_covered", "shader_invocations",
                             "threads", "transform_ms", "setup_ms", "raster_ms"})
         EXPECT_NE(j.find(std::string("\"") + key + "\": "), std::string::npos) << key;

@@ -4,6 +4,7 @@
 // rule's statement written out per case.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -558,6 +559,93 @@ TEST(TriangleSetup, DepthAtASampleIsTheCorrectlyRoundedPlaneValue) {
     }
     EXPECT_GT(checked, 10000u);
     EXPECT_EQ(wrong, 0u) << wrong << " of " << checked << " depths are not the correctly rounded plane value";
+}
+
+// A triangle's bounds are the pixels with a sample position inside its box (Viewport's sample
+// extent): every sample the oracle finds covered lies in them, and they are exactly the pixels
+// whose span of sample offsets meets the box (found here by scanning, not by the setup's
+// ⌈·⌉/⌊·⌋); a triangle whose box holds no sample position is not set up: counted as outside where
+// the box meets no pixel of the viewport, else as between the samples.
+// Small random triangles (many between samples) for the documented patterns' extents and the
+// whole-pixel default.
+TEST(TriangleSetup, BoundsAreThePixelsWithASamplePositionInTheTrianglesBox) {
+    constexpr int W = 40, H = 30;
+    const std::vector<oracle::Pattern> patterns = {oracle::center_pattern(), oracle::rotated_pattern(),
+                                                   oracle::grid_pattern(4), oracle::Pattern{{5, 250}, {77, 200}}};
+    std::mt19937_64 rng(20261130);
+    std::uniform_int_distribution<int> corner(-3 * 256, (W + 3) * 256), spread(0, 3 * 256);
+    std::size_t set_up = 0, between_samples = 0, covered_samples = 0;
+    for (std::size_t k = 0; k <= patterns.size(); ++k) {
+        const bool whole_pixel = k == patterns.size();  // the defaults: any offset in the pixel
+        const oracle::Pattern pattern = whole_pixel ? oracle::center_pattern() : patterns[k];
+        mr::Viewport vp{W, H, mr::DepthConvention::reverse_z};
+        if (!whole_pixel) {
+            vp.sample_x0 = *std::min_element(pattern.x.begin(), pattern.x.end());
+            vp.sample_x1 = *std::max_element(pattern.x.begin(), pattern.x.end());
+            vp.sample_y0 = *std::min_element(pattern.y.begin(), pattern.y.end());
+            vp.sample_y1 = *std::max_element(pattern.y.begin(), pattern.y.end());
+        }
+        // The pixels along one axis whose samples' span [p·256 + lo, p·256 + hi] meets [a, b].
+        const auto scan = [](std::int64_t a, std::int64_t b, int lo, int hi, int n, int& first, int& last) {
+            first = n, last = -1;
+            for (int p = 0; p < n; ++p) {
+                const std::int64_t corner = std::int64_t{p} * 256;
+                if (corner + hi >= a && corner + lo <= b) first = std::min(first, p), last = p;
+            }
+        };
+        for (int t = 0; t < 3000; ++t) {
+            const int x0 = corner(rng), y0 = corner(rng) * H / W;
+            const int size = t % 3 == 0 ? 64 : spread(rng);  // a third smaller than a pixel
+            std::array<mr::ScreenVertex, 3> v{};
+            std::array<oracle::Fixed2, 3> f;
+            std::uniform_int_distribution<int> offset(0, size);
+            for (int i = 0; i < 3; ++i) {
+                v[i].x = x0 + offset(rng), v[i].y = y0 + offset(rng), v[i].inv_w = 1.0, v[i].depth = 0.5;
+                f[i] = {v[i].x, v[i].y};
+            }
+            mr::SetupTriangle st;
+            mr::SetupCounters counters;
+            const bool ok = mr::setup_triangle(v, vp, mr::CullMode::none, st, counters);
+            if (oracle::is_degenerate(f)) {
+                EXPECT_FALSE(ok);
+                continue;
+            }
+            const std::int64_t lo_x = std::min({f[0].x, f[1].x, f[2].x}), hi_x = std::max({f[0].x, f[1].x, f[2].x});
+            const std::int64_t lo_y = std::min({f[0].y, f[1].y, f[2].y}), hi_y = std::max({f[0].y, f[1].y, f[2].y});
+            int first_x, last_x, first_y, last_y, any_x0, any_x1, any_y0, any_y1;
+            scan(lo_x, hi_x, vp.sample_x0, vp.sample_x1, W, first_x, last_x);
+            scan(lo_y, hi_y, vp.sample_y0, vp.sample_y1, H, first_y, last_y);
+            scan(lo_x, hi_x, 0, 255, W, any_x0, any_x1);  // the pixels the box meets at all
+            scan(lo_y, hi_y, 0, 255, H, any_y0, any_y1);
+            const bool some_pixel = first_x <= last_x && first_y <= last_y;
+            const bool meets_view = any_x0 <= any_x1 && any_y0 <= any_y1;
+            ASSERT_EQ(ok, some_pixel) << "pattern " << k << ", triangle " << t;
+            if (!ok) {
+                EXPECT_EQ(counters.culled_outside, meets_view ? 0u : 1u);
+                EXPECT_EQ(counters.culled_between_samples, meets_view ? 1u : 0u);
+                between_samples += meets_view;
+                continue;
+            }
+            ++set_up;
+            EXPECT_EQ(st.min_x, first_x);
+            EXPECT_EQ(st.max_x, last_x);
+            EXPECT_EQ(st.min_y, first_y);
+            EXPECT_EQ(st.max_y, last_y);
+            for (int py = 0; py < H; ++py)
+                for (int px = 0; px < W; ++px)
+                    for (int s = 0; s < pattern.count(); ++s) {
+                        const oracle::Fixed2 p = oracle::sample_position(px, py, pattern, s);
+                        if (!oracle::covers(f, p.x, p.y)) continue;
+                        ++covered_samples;
+                        ASSERT_TRUE(px >= st.min_x && px <= st.max_x && py >= st.min_y && py <= st.max_y)
+                            << "pattern " << k << ": covered sample " << s << " of pixel " << px << "," << py
+                            << " outside the bounds";
+                    }
+        }
+    }
+    EXPECT_GT(set_up, 5000u);
+    EXPECT_GT(covered_samples, 5000u);
+    EXPECT_GT(between_samples, 100u);  // triangles inside the viewport between its samples
 }
 
 }  // namespace

@@ -80,6 +80,7 @@ void expect_fours_agree(const std::vector<std::array<mr::ScreenVertex, 3>>& tria
         ASSERT_EQ(four_counts.culled_degenerate, one_counts.culled_degenerate);
         ASSERT_EQ(four_counts.culled_backface, one_counts.culled_backface);
         ASSERT_EQ(four_counts.culled_outside, one_counts.culled_outside);
+        ASSERT_EQ(four_counts.culled_between_samples, one_counts.culled_between_samples);
         ++tally.groups;
         tally.triangles += n;
     }
@@ -96,10 +97,16 @@ TEST(TriangleSetupFours, RandomClipSpaceTrianglesGiveTheScalarBitsOutcomesAndCou
     std::mt19937_64 rng(20261129);
     std::uniform_real_distribution<double> unit(-1.0, 1.0), w_of(0.01, 50.0), log_scale(-12.0, 3.0);
     Tally tally;
+    // (With the whole pixel for the samples, and the extents of a centre sample, the rotated
+    // pattern and an uneven one.)
     const mr::Viewport viewports[] = {{1920, 1080, mr::DepthConvention::opengl},
                                       {1, 1, mr::DepthConvention::reverse_z},
                                       {333, 7, mr::DepthConvention::reverse_z},
-                                      {mr::kMaxDimension, mr::kMaxDimension, mr::DepthConvention::opengl}};
+                                      {mr::kMaxDimension, mr::kMaxDimension, mr::DepthConvention::opengl},
+                                      {1920, 1080, mr::DepthConvention::opengl, 128, 128, 128, 128},
+                                      {2, 3, mr::DepthConvention::reverse_z, 128, 128, 128, 128},
+                                      {640, 480, mr::DepthConvention::reverse_z, 32, 224, 32, 224},
+                                      {mr::kMaxDimension, 999, mr::DepthConvention::opengl, 3, 255, 0, 97}};
     for (const mr::Viewport& viewport : viewports) {
         std::vector<std::array<mr::ScreenVertex, 3>> triangles;
         for (int t = 0; t < 4000; ++t) {

@@ -141,7 +141,8 @@ def test_stats_and_repr():
     scene, camera = mr.Scene.demo()
     result = mr.render(scene, camera, 32, 18, threads=2)
     assert set(result.stats) == {
-        "triangles_in", "triangles_clipped", "triangles_outside", "triangles_backface", "triangles_degenerate",
+        "triangles_in", "triangles_clipped", "triangles_outside", "triangles_between_samples", "triangles_backface",
+        "triangles_degenerate",
         "triangles_nonfinite", "triangles_rasterized", "samples_covered", "samples_passed",
         "shader_invocations", "depth_blocks_rejected", "tiles_deferred", "tiles_empty", "threads", "transform_ms", "setup_ms", "raster_ms", "total_ms"}
     assert result.stats["triangles_in"] == sum(d.mesh.triangle_count for d in scene.draws)

@@ -237,6 +237,7 @@ void setup_range(const ChunkRange& range, const ClipSpaceGeometry& vertices, con
                     if (pieces.culled_backface) ++counters.culled_backface;
                     else if (pieces.dropped_nonfinite) ++counters.dropped_nonfinite;
                     else if (pieces.culled_outside) ++counters.culled_outside;
+                    else if (pieces.culled_between_samples) ++counters.culled_between_samples;
                     else ++counters.culled_degenerate;
                 }
                 break;
@@ -319,6 +320,7 @@ std::vector<BinnedChunk> setup_and_bin(const std::vector<ClipSpaceGeometry>& geo
     for (std::size_t i = 0; i < chunk_runs.size(); ++i) {
         stats.triangles_clipped += clipped[i];
         stats.triangles_outside += setup_counters[i].culled_outside;
+        stats.triangles_between_samples += setup_counters[i].culled_between_samples;
         stats.triangles_backface += setup_counters[i].culled_backface;
         stats.triangles_degenerate += setup_counters[i].culled_degenerate;
         stats.triangles_nonfinite += setup_counters[i].dropped_nonfinite;
@@ -428,6 +430,17 @@ void rasterize_tile_deferred(std::size_t tile, const std::vector<BinnedChunk>& c
         while (i < refs.size() && refs[i].triangle->draw == draw) ++i;
     }
     ++counters.tiles_deferred;
+}
+
+// The viewport of a render whose pixels hold the samples of `pattern`: their extent bounds each
+// triangle's pixels (Viewport).
+Viewport sample_viewport(int width, int height, DepthConvention convention, const SamplePattern& pattern) {
+    Viewport v{width, height, convention};
+    v.sample_x0 = *std::min_element(pattern.x.begin(), pattern.x.end());
+    v.sample_x1 = *std::max_element(pattern.x.begin(), pattern.x.end());
+    v.sample_y0 = *std::min_element(pattern.y.begin(), pattern.y.end());
+    v.sample_y1 = *std::max_element(pattern.y.begin(), pattern.y.end());
+    return v;
 }
 
 // The pixel rectangle of a tile; its storage windows are the caller's to set.
@@ -566,7 +579,7 @@ RenderResult render(const std::vector<Draw>& draws, const Camera& camera, const 
     // Stage 1: vertex transform, per draw, in parallel over blocks of vertices.
     auto t0 = Clock::now();
     const ClipVolume volume = make_clip_volume(camera.depth_convention, settings.width, settings.height);
-    const Viewport viewport{settings.width, settings.height, camera.depth_convention};
+    const Viewport viewport = sample_viewport(settings.width, settings.height, camera.depth_convention, result.pattern);
     std::vector<ClipSpaceGeometry> geometry(draws.size());
     for (std::size_t d = 0; d < draws.size(); ++d) {
         const Mesh& mesh = *draws[d].mesh;
@@ -833,7 +846,7 @@ Visibility rasterize(const std::vector<glm::dvec4>& clip_positions, const std::v
     // Stage 1: outcodes and screen positions of the given clip-space vertices.
     auto t0 = Clock::now();
     const ClipVolume volume = make_clip_volume(settings.depth_convention, settings.width, settings.height);
-    const Viewport viewport{settings.width, settings.height, settings.depth_convention};
+    const Viewport viewport = sample_viewport(settings.width, settings.height, settings.depth_convention, out.pattern);
     std::vector<ClipSpaceGeometry> geometry(1);
     ClipSpaceGeometry& g = geometry[0];
     resize_vertices(g, clip_positions.size());
@@ -918,7 +931,9 @@ std::string RenderStats::to_json() const {
         return std::string("\"") + name + "\": " + v + (last ? "" : ", ");
     };
     return "{" + field("triangles_in", triangles_in) + field("triangles_clipped", triangles_clipped) +
-           field("triangles_outside", triangles_outside) + field("triangles_backface", triangles_backface) +
+           field("triangles_outside", triangles_outside) +
+           field("triangles_between_samples", triangles_between_samples) +
+           field("triangles_backface", triangles_backface) +
            field("triangles_degenerate", triangles_degenerate) + field("triangles_nonfinite", triangles_nonfinite) +
            field("triangles_rasterized", triangles_rasterized) + field("samples_covered", samples_covered) +
            field("samples_passed", samples_passed) + field("shader_invocations", shader_invocations) +
@@ -933,7 +948,9 @@ std::string RenderStats::to_string() const {
         return std::string(buf);
     };
     return "RenderStats(triangles_in=" + std::to_string(triangles_in) + ", clipped=" + std::to_string(triangles_clipped) +
-           ", outside=" + std::to_string(triangles_outside) + ", backface=" + std::to_string(triangles_backface) +
+           ", outside=" + std::to_string(triangles_outside) +
+           ", between_samples=" + std::to_string(triangles_between_samples) +
+           ", backface=" + std::to_string(triangles_backface) +
            ", degenerate=" + std::to_string(triangles_degenerate) + ", nonfinite=" + std::to_string(triangles_nonfinite) +
            ", rasterized=" + std::to_string(triangles_rasterized) + ", samples_covered=" + std::to_string(samples_covered) +
            ", samples_passed=" + std::to_string(samples_passed) + ", shader_invocations=" +

@@ -47,13 +47,25 @@ bool setup_triangle(const std::array<ScreenVertex, 3>& v, const Viewport& viewpo
         return false;
     }
 
-    // Step 3: bounds in pixels: pixel px holds samples at px·256 + [0, 255].
-    const std::int64_t min_x = std::max<std::int64_t>(floor_to_pixel(std::min({X[0], X[1], X[2]})), 0);
-    const std::int64_t max_x = std::min<std::int64_t>(floor_to_pixel(std::max({X[0], X[1], X[2]})), viewport.width - 1);
-    const std::int64_t min_y = std::max<std::int64_t>(floor_to_pixel(std::min({Y[0], Y[1], Y[2]})), 0);
-    const std::int64_t max_y = std::min<std::int64_t>(floor_to_pixel(std::max({Y[0], Y[1], Y[2]})), viewport.height - 1);
-    if (min_x > max_x || min_y > max_y) {
+    // Step 3: bounds in pixels: those with a sample position inside the triangle's box. Pixel px
+    // holds its samples at px·256 + [sample_x0, sample_x1], so it is one from
+    // ⌈(min X − sample_x1) / 256⌉ to ⌊(max X − sample_x0) / 256⌋. A box that meets no pixel of the
+    // viewport is outside it; one that meets some but no sample position, between the samples.
+    const std::int64_t lo_x = std::min({X[0], X[1], X[2]}), hi_x = std::max({X[0], X[1], X[2]});
+    const std::int64_t lo_y = std::min({Y[0], Y[1], Y[2]}), hi_y = std::max({Y[0], Y[1], Y[2]});
+    if (floor_to_pixel(hi_x) < 0 || floor_to_pixel(lo_x) >= viewport.width || floor_to_pixel(hi_y) < 0 ||
+        floor_to_pixel(lo_y) >= viewport.height) {
         ++counters.culled_outside;
+        return false;
+    }
+    const std::int64_t to_first_x = kSubpixelOne - 1 - viewport.sample_x1;
+    const std::int64_t to_first_y = kSubpixelOne - 1 - viewport.sample_y1;
+    const std::int64_t min_x = std::max<std::int64_t>(floor_to_pixel(lo_x + to_first_x), 0);
+    const std::int64_t max_x = std::min<std::int64_t>(floor_to_pixel(hi_x - viewport.sample_x0), viewport.width - 1);
+    const std::int64_t min_y = std::max<std::int64_t>(floor_to_pixel(lo_y + to_first_y), 0);
+    const std::int64_t max_y = std::min<std::int64_t>(floor_to_pixel(hi_y - viewport.sample_y0), viewport.height - 1);
+    if (min_x > max_x || min_y > max_y) {
+        ++counters.culled_between_samples;
         return false;
     }
 

@@ -98,15 +98,24 @@ inline __m128i to_pixel(__m128i x) { return _mm_srai_epi32(x, kSubpixelBits); }
     const int counter_clockwise = ~clockwise & ~degenerate & 0xF;
     const int culled = cull == CullMode::back ? clockwise : cull == CullMode::front ? counter_clockwise : 0;
 
-    // Step 3: bounds in pixels (⌊x / 256⌋: an arithmetic shift), inside the viewport.
+    // Step 3: bounds in pixels (⌊x / 256⌋: an arithmetic shift), those with a sample position inside
+    // the triangle's box, inside the viewport; outside it, or between the samples (as setup_triangle).
     const __m128i zero32 = _mm_setzero_si128();
-    const __m128i min_x = _mm_max_epi32(to_pixel(_mm_min_epi32(_mm_min_epi32(X[0], X[1]), X[2])), zero32);
-    const __m128i max_x = _mm_min_epi32(to_pixel(_mm_max_epi32(_mm_max_epi32(X[0], X[1]), X[2])),
-                                        _mm_set1_epi32(viewport.width - 1));
-    const __m128i min_y = _mm_max_epi32(to_pixel(_mm_min_epi32(_mm_min_epi32(Y[0], Y[1]), Y[2])), zero32);
-    const __m128i max_y = _mm_min_epi32(to_pixel(_mm_max_epi32(_mm_max_epi32(Y[0], Y[1]), Y[2])),
-                                        _mm_set1_epi32(viewport.height - 1));
-    const int outside = _mm_movemask_ps(
+    const __m128i last_x = _mm_set1_epi32(viewport.width - 1), last_y = _mm_set1_epi32(viewport.height - 1);
+    const __m128i lo_x = _mm_min_epi32(_mm_min_epi32(X[0], X[1]), X[2]);
+    const __m128i hi_x = _mm_max_epi32(_mm_max_epi32(X[0], X[1]), X[2]);
+    const __m128i lo_y = _mm_min_epi32(_mm_min_epi32(Y[0], Y[1]), Y[2]);
+    const __m128i hi_y = _mm_max_epi32(_mm_max_epi32(Y[0], Y[1]), Y[2]);
+    const int outside = _mm_movemask_ps(_mm_castsi128_ps(
+        _mm_or_si128(_mm_or_si128(_mm_cmpgt_epi32(zero32, to_pixel(hi_x)), _mm_cmpgt_epi32(to_pixel(lo_x), last_x)),
+                     _mm_or_si128(_mm_cmpgt_epi32(zero32, to_pixel(hi_y)), _mm_cmpgt_epi32(to_pixel(lo_y), last_y)))));
+    const __m128i to_first_x = _mm_set1_epi32(Viewport::kLastSubpixel - viewport.sample_x1);
+    const __m128i to_first_y = _mm_set1_epi32(Viewport::kLastSubpixel - viewport.sample_y1);
+    const __m128i min_x = _mm_max_epi32(to_pixel(_mm_add_epi32(lo_x, to_first_x)), zero32);
+    const __m128i max_x = _mm_min_epi32(to_pixel(_mm_sub_epi32(hi_x, _mm_set1_epi32(viewport.sample_x0))), last_x);
+    const __m128i min_y = _mm_max_epi32(to_pixel(_mm_add_epi32(lo_y, to_first_y)), zero32);
+    const __m128i max_y = _mm_min_epi32(to_pixel(_mm_sub_epi32(hi_y, _mm_set1_epi32(viewport.sample_y0))), last_y);
+    const int between_samples = _mm_movemask_ps(
         _mm_castsi128_ps(_mm_or_si128(_mm_cmpgt_epi32(min_x, max_x), _mm_cmpgt_epi32(min_y, max_y))));
 
     // Each triangle's outcome, under the first reason that applies, as setup_triangle counts it.
@@ -117,6 +126,7 @@ inline __m128i to_pixel(__m128i x) { return _mm_srai_epi32(x, kSubpixelBits); }
         else if (degenerate & bit) ++counters.culled_degenerate;
         else if (culled & bit) ++counters.culled_backface;
         else if (outside & bit) ++counters.culled_outside;
+        else if (between_samples & bit) ++counters.culled_between_samples;
         else set_up |= bit;
     }
     if (!set_up) return 0;

@@ -95,6 +95,7 @@ struct RenderStats {
     std::uint64_t triangles_in = 0;        ///< submitted triangles
     std::uint64_t triangles_clipped = 0;   ///< crossed a clip plane and were clipped
     std::uint64_t triangles_outside = 0;   ///< entirely outside the clip volume or the viewport
+    std::uint64_t triangles_between_samples = 0;  ///< in the viewport, no sample position in its box
     std::uint64_t triangles_backface = 0;  ///< removed by face culling
     std::uint64_t triangles_degenerate = 0;///< zero area after snapping
     std::uint64_t triangles_nonfinite = 0; ///< non-finite after transform (e.g. a degenerate matrix): dropped

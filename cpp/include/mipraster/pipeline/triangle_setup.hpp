@@ -37,11 +37,19 @@ using ClipWeights = std::array<glm::vec3, 3>;
 /// What setup rejected, by reason.
 struct SetupCounters {
     std::uint64_t culled_backface = 0, culled_degenerate = 0, culled_outside = 0, dropped_nonfinite = 0;
+    std::uint64_t culled_between_samples = 0;  ///< in the viewport, with no sample position in its box
 };
 
 struct Viewport {
     int width = 0, height = 0;
     DepthConvention depth_convention = DepthConvention::reverse_z;
+    /// Where a pixel's samples lie, in 1/256 px from its top-left corner: the smallest and largest
+    /// offsets of the sample pattern in x and y. A triangle's bounds are the pixels with a sample
+    /// position inside its box, so that a small triangle visits fewer pixels and tiles, and one
+    /// between the samples is not set up (culled_between_samples). (The defaults, the whole pixel,
+    /// suit every pattern.)
+    static constexpr std::int32_t kLastSubpixel = static_cast<std::int32_t>(kSubpixelOne - 1);
+    std::int32_t sample_x0 = 0, sample_x1 = kLastSubpixel, sample_y0 = 0, sample_y1 = kLastSubpixel;
 };
 
 /// A clip-space vertex on the screen: its position snapped to 1/256 px (y down), how far the
