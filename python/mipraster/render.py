@@ -61,8 +61,7 @@ class RenderResult:
         stats: dict of the renderer's counters (``triangles_in``, ``triangles_clipped``,
             ``triangles_outside``, ``triangles_between_samples``: in the view, but with no sample
             position inside its bounding box (left out before binning), ``triangles_backface``,
-            ``triangles_degenerate``,
-            ``triangles_nonfinite``, ``triangles_rasterized``, ``samples_covered``,
+            ``triangles_degenerate``, ``triangles_nonfinite``, ``triangles_rasterized``, ``samples_covered``,
             ``samples_passed``: of those, the ones that passed the depth test and any alpha test (as an
             OpenGL occlusion query counts), ``shader_invocations``, ``depth_blocks_rejected``, ``tiles_deferred``: tiles
             whose visible samples were shaded after a pre-pass, ``tiles_empty``: tiles no triangle

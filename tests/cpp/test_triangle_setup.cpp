@@ -595,7 +595,7 @@ TEST(TriangleSetup, BoundsAreThePixelsWithASamplePositionInTheTrianglesBox) {
         };
         for (int t = 0; t < 3000; ++t) {
             const int x0 = corner(rng), y0 = corner(rng) * H / W;
-            const int size = t % 3 == 0 ? 64 : spread(rng);  // a third smaller than a pixel
+            const int size = t % 3 == 0 ? 64 : spread(rng);  // a third of them within a quarter pixel
             std::array<mr::ScreenVertex, 3> v{};
             std::array<oracle::Fixed2, 3> f;
             std::uniform_int_distribution<int> offset(0, size);
