@@ -312,6 +312,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
     const SamplePattern& pattern = *target.pattern;
     const int S = kMode == SampleMode::single ? 1 : pattern.count();
     constexpr std::int64_t kStep = kSubpixelOne;  // one pixel in fixed point
+    const std::int64_t sample_x = pattern.x[0], sample_y = pattern.y[0];  // (sample 0's offsets)
     TileBlocks blocks(target, S);
     // Coverage masks four samples per vector (pixel_coverage_avx2; also MSAA's depth tests,
     // pixel_vectors below).
@@ -395,17 +396,22 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             }
         }
 
-        // Edge offsets of each sample from its pixel's corner: a·ox + b·oy.
+        // Edge offsets of each sample from its pixel's corner: a·ox + b·oy. (At one sample a pixel,
+        // after the box path below, which needs none: many_small 1x spent 27 instructions of a
+        // small triangle's 560 in a tile on them.)
         std::int64_t off0[kMaxSamples], off1[kMaxSamples], off2[kMaxSamples];
-        if (vector_masks) {
-            sample_offsets_avx2(t, pattern.x.data(), pattern.y.data(), S, {off0, off1, off2});
-        } else {
+        const auto sample_offsets = [&] {
+            if (vector_masks) {
+                sample_offsets_avx2(t, pattern.x.data(), pattern.y.data(), S, {off0, off1, off2});
+                return;
+            }
             for (int s = 0; s < S; ++s) {
                 off0[s] = std::int64_t{t.edge_a[0]} * pattern.x[s] + std::int64_t{t.edge_b[0]} * pattern.y[s];
                 off1[s] = std::int64_t{t.edge_a[1]} * pattern.x[s] + std::int64_t{t.edge_b[1]} * pattern.y[s];
                 off2[s] = std::int64_t{t.edge_a[2]} * pattern.x[s] + std::int64_t{t.edge_b[2]} * pattern.y[s];
             }
-        }
+        };
+        if constexpr (kMode != SampleMode::single) sample_offsets();
         const std::int64_t step0 = t.edge_a[0] * kStep, step1 = t.edge_a[1] * kStep, step2 = t.edge_a[2] * kStep;
         // Edge offsets of a pixel's centre from its corner (MSAA shades there when it is inside).
         const std::int64_t to_centre0 = (std::int64_t{t.edge_a[0]} + t.edge_b[0]) * (kStep / 2);
@@ -632,9 +638,12 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
         // at one sample: many_small 1x, a third of the kernel's instructions; box_sample_masks_avx2
         // with four samples a vector: many_small SSAA 4x −8 %, MSAA 4x −9 %).
         if (box_rows && !classified && x1 - x0 < kSampleRowMinPixels) {
-            // Edge values at the corner of pixel (x0, y0), and the pixel's slots: the per-sample
-            // path's integers, and addresses from the windows' fields read once.
-            const std::int64_t X = std::int64_t{x0} * kStep, Y = std::int64_t{y0} * kStep;
+            // Edge values at the corner of pixel (x0, y0) (at one sample a pixel, at its sample: the
+            // corner's plus the sample's offset, the same integers), and the pixel's slots: the
+            // per-sample path's integers, and addresses from the windows' fields read once.
+            const bool at_sample = kMode == SampleMode::single;
+            const std::int64_t X = std::int64_t{x0} * kStep + (at_sample ? sample_x : 0);
+            const std::int64_t Y = std::int64_t{y0} * kStep + (at_sample ? sample_y : 0);
             std::int64_t e[3] = {t.edge_a[0] * X + t.edge_b[0] * Y + t.edge_c[0],
                                  t.edge_a[1] * X + t.edge_b[1] * Y + t.edge_c[1],
                                  t.edge_a[2] * X + t.edge_b[2] * Y + t.edge_c[2]};
@@ -668,7 +677,6 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
                 }
                 continue;
             }
-            e[0] += off0[0], e[1] += off1[0], e[2] += off2[0];  // (at its one sample)
             std::uint8_t cover[kTileSize];
             if (!box_coverage_avx2(e, {step0, step1, step2}, down, x1 - x0, y1 - y0, cover)) continue;
             for (int py = y0; py < y1; ++py) {
@@ -698,6 +706,7 @@ void raster_tile(const TileTarget& target, const DrawInputs& draw, const Triangl
             continue;
         }
 
+        if constexpr (kMode == SampleMode::single) sample_offsets();
         for (int py = y0; py < y1; ++py) {
             int rx0 = x0, rx1 = x1;  // the row without skipped blocks at its ends
             blocks.trim(cls.skipped, py, rx0, rx1);
