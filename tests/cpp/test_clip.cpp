@@ -524,6 +524,52 @@ TEST(Clip, ProjectsToALineFindsZeroAreaButNotThinTriangles) {
     const double half_px = 1.0 / 128.0;  // NDC per px at W = 256
     EXPECT_FALSE(mr::projects_to_a_line({glm::dvec4(-16777216.0, 0, 0, 1), glm::dvec4(16777216.0, 0, 0, 1),
                                          glm::dvec4(0.0, 1e-3 * half_px, 0, 1)}));
+    // A sliver whose determinant is 10^-16 of its permanent, below double's rounding and far above
+    // binary128's, is a triangle; exactly collinear points are not.
+    EXPECT_FALSE(mr::projects_to_a_line({glm::dvec4(1, 1, 0, 1), glm::dvec4(2, 2, 0, 1),
+                                         glm::dvec4(3, std::nextafter(3.0, 4.0), 0, 1)}));
+    EXPECT_TRUE(mr::projects_to_a_line({glm::dvec4(1, 1, 0, 1), glm::dvec4(2, 2, 0, 1), glm::dvec4(3, 3, 0, 1)}));
+}
+
+TEST(Clip, ProjectsToALineGivesTheSameAnswerAtAnyScale) {
+    // The same line and the same triangle with every coordinate scaled by 10^-200 … 10^200, and
+    // with each vertex scaled by its own factor (the same projective point): products of 10^160
+    // overflowed and of 10^-200 vanished, and the triangle counted as a line.
+    for (const double scale : {1e-200, 1e-100, 1.0, 1e100, 1e160, 1e200}) {
+        for (const double own : {1.0, 1e-50, 1e50}) {
+            const glm::dvec4 a = glm::dvec4(1, 2, 0, 1) * scale, c = glm::dvec4(-3, -6, 0, 1) * scale;
+            EXPECT_TRUE(mr::projects_to_a_line({a, glm::dvec4(2, 4, 0, 1) * scale * own, c})) << scale << " " << own;
+            EXPECT_FALSE(mr::projects_to_a_line({a, glm::dvec4(2, 5, 0, 1) * scale * own, c})) << scale << " " << own;
+        }
+    }
+}
+
+TEST(Clip, ATriangleWhoseWLieBelowTheSmallestClipWIsScaledNotCutAway) {
+    // Clip-space w of 10^-40 (below kMinClipW = 10^-30), x, y and z in proportion: projected, the
+    // triangle lies inside the viewport. It comes out whole (no vertex moved on screen or in
+    // depth, the weights its own), where the absolute plane w ≥ kMinClipW cut it all away.
+    const mr::ClipVolume volume = mr::make_clip_volume(mr::DepthConvention::reverse_z, 64, 64);
+    const double w = 1e-40;
+    const std::array<glm::dvec4, 3> p = {glm::dvec4(-0.5 * w, -0.5 * w, 0.25 * w, w),
+                                         glm::dvec4(0.5 * w, -0.5 * w, 0.5 * w, w),
+                                         glm::dvec4(0.0, 0.5 * w, 0.75 * w, 2 * w)};
+    const std::array<std::uint8_t, 3> codes = {mr::outcode(p[0], volume), mr::outcode(p[1], volume),
+                                               mr::outcode(p[2], volume)};
+    ASSERT_NE(codes[0] & codes[1] & codes[2], 0);  // every vertex outside w ≥ kMinClipW
+    mr::ClipPolygon polygon;
+    ASSERT_EQ(mr::clip_triangle(p, codes, volume, polygon), mr::ClipOutcome::clipped);
+    ASSERT_EQ(polygon.count, 3);
+    for (int k = 0; k < 3; ++k) {
+        const glm::dvec4 q = polygon.vertices[k].position;
+        EXPECT_EQ(q.x / q.w, p[k].x / p[k].w) << k;
+        EXPECT_EQ(q.y / q.w, p[k].y / p[k].w) << k;
+        EXPECT_EQ(q.z / q.w, p[k].z / p[k].w) << k;
+        EXPECT_EQ(polygon.vertices[k].weights[k], 1.0) << k;
+        EXPECT_EQ(polygon.vertices[k].weights[(k + 1) % 3], 0.0) << k;
+    }
+    // Its w, all scaled by one power of two, keep their ratios (perspective-correct weights).
+    EXPECT_EQ(polygon.vertices[2].position.w, 2 * polygon.vertices[0].position.w);
+    EXPECT_GE(polygon.vertices[2].position.w, 1.0);
 }
 
 }  // namespace

@@ -458,21 +458,24 @@ def exact_coverage(pos, width, height, band=0.01):
             inside, near = True, False
             for (x0, y0), (x1, y1) in zip(screen, screen[1:] + screen[:1]):
                 cross = (x1 - x0) * (py - y0) - (y1 - y0) * (px - x0)
-                near |= abs(float(cross)) < band * float(np.hypot(float(x1 - x0), float(y1 - y0)))
+                near |= cross * cross < Fraction(band) ** 2 * ((x1 - x0) ** 2 + (y1 - y0) ** 2)  # (beyond float)
                 inside &= cross * orientation >= 0
             out[row, col] = None if near else inside
     return out
 
 
-def test_edges_between_vertices_far_beyond_the_guard_band_cross_the_image_exactly():
-    # An edge whose two vertices lie 10^15 to 10^30 px out on opposite sides, its line through the
+@pytest.mark.parametrize("seed, lowest, highest", [(7, 15, 30), (8, 30, 300)])
+def test_edges_between_vertices_far_beyond_the_guard_band_cross_the_image_exactly(seed, lowest, highest):
+    # An edge whose two vertices lie 10^15 to 10^300 px out on opposite sides, its line through the
     # image: its crossings of the guard band are small differences of huge numbers (10^21 px
-    # covered nothing, 10^22 a quarter of the pixels). Lines through the centre at any angle, or
-    # along a row or a column; scaling by powers of two keeps the intended line exact.
-    rng = np.random.default_rng(7)
+    # covered nothing, 10^22 a quarter of the pixels; beyond 10^40, where binary128 no longer held
+    # the crossing's parameter, half the image was lost, and from 10^155 the triangle was dropped
+    # as degenerate). Lines through the centre at any angle, or along a row or a column; scaling by
+    # powers of two keeps the intended line exact.
+    rng = np.random.default_rng(seed)
     W, H = 24, 16
     for trial in range(60):
-        e = rng.uniform(15, 30)
+        e = rng.uniform(lowest, highest)
         angle = rng.uniform(0, 2 * np.pi)
         d = 10**e * np.array([np.cos(angle), np.sin(angle)])
         if trial % 3 == 0:
@@ -483,7 +486,9 @@ def test_edges_between_vertices_far_beyond_the_guard_band_cross_the_image_exactl
             v0[axis] = 10**e
             v1 = v0.copy()
             v1[axis] = -(10**e) * 2.0 ** rng.integers(-3, 4)
-        side = 10 ** rng.uniform(15, 30) * np.array([-np.sin(angle), np.cos(angle)])
+        # The third vertex's offset from the edge's line: up to 10^28 times smaller than the edge
+        # is long (double cannot tell such a sliver from a line, binary128 can).
+        side = 10 ** np.clip(e + rng.uniform(-28, 15), lowest, highest) * np.array([-np.sin(angle), np.cos(angle)])
         ndc = np.array([v0, v1, side + rng.uniform(-0.3, 0.3) * d])
         w = 2.0 ** rng.integers(-3, 4, 3).astype(float)
         pos = np.concatenate([ndc * w[:, None], rng.uniform(-0.5, 0.5, (3, 1)) * w[:, None], w[:, None]], axis=1)
@@ -495,8 +500,8 @@ def test_edges_between_vertices_far_beyond_the_guard_band_cross_the_image_exactl
 
 
 def test_huge_triangle_through_a_camera_covers_what_a_small_one_does():
-    # The same triangle scaled by 10^3 … 10^30, and a camera zoomed in 10^20 times: the upper half
-    # of the image each time.
+    # The same triangle scaled by 10^3 … 10^30 (and by its model matrix to 10^300), and a camera
+    # zoomed in 10^20 times: the upper half of the image each time.
     camera = mr.Camera.look_at((0, 0, 3), (0, 0, 0))
     triangle = np.array([[-1, 0, 0], [1, 0, 0], [0, 1, 0]], float)
     for k in (1e3, 1e20, 1e21, 1e22, 1e30):
@@ -504,8 +509,18 @@ def test_huge_triangle_through_a_camera_covers_what_a_small_one_does():
         scene.add(mr.Mesh(triangle * k, [[0, 1, 2]]))
         alpha = mr.render(scene, camera, 16, 16).color[..., 3]
         assert np.array_equal(alpha, np.repeat([[1.0], [0.0]], 8, axis=0) * np.ones((16, 16))), k
+    # Beyond float32 through the model matrix (10^50: half the image; 10^160: nothing), and the
+    # same triangle 10^50 times larger through a w scaled down (within 10^-30 of the eye in clip
+    # space: cut away by the plane w ≥ 10^-30 before it was scaled up for clipping).
+    mesh = mr.Mesh(triangle, [[0, 1, 2]])
+    for model in (np.diag([1e39, 1e39, 1e39, 1]), np.diag([1e50, 1e50, 1e50, 1]), np.diag([1e160, 1e160, 1e160, 1]),
+                  np.diag([1e300, 1e300, 1e300, 1]), np.diag([1, 1, 1, 1e-50])):
+        scene = mr.Scene()
+        scene.add(mesh, model=model)
+        alpha = mr.render(scene, camera, 16, 16).color[..., 3]
+        assert np.array_equal(alpha, np.repeat([[1.0], [0.0]], 8, axis=0) * np.ones((16, 16))), model
     scene = mr.Scene()
-    scene.add(mr.Mesh(triangle, [[0, 1, 2]]))
+    scene.add(mesh)
     zoomed = mr.render(scene, mr.Camera.look_at((0, 0, 3), (0, 0, 0), fov_y=1e-20), 16, 16).color[..., 3]
     assert zoomed[:8].all() and not zoomed[8:].any()
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "mipraster/core/constants.hpp"
 
@@ -37,9 +38,25 @@ bool lexicographically_less(const glm::dvec4& a, const glm::dvec4& b) {
 
 #if defined(__SIZEOF_FLOAT128__)
 using Quad = __float128;  // (IEEE binary128 in software: 113-bit significands)
+constexpr Quad kQuadEpsilon = 0x1p-112;
 #else
 using Quad = long double;
+constexpr Quad kQuadEpsilon = std::numeric_limits<long double>::epsilon();
 #endif
+
+// Coordinate i of the point where edge (a, b) crosses the plane, whose distances from it are da and
+// db (of opposite signs): (da·b − db·a)/(da − db), written as Σ_j n_j·(a_j·b_i − b_j·a_i) plus the
+// offset's term over da − db. Each 2×2 minor is a difference of exact products, rounded once, so
+// it keeps its own relative precision however large a and b are; a + t·(b − a) did not: with
+// both endpoints 10^50 × w out and the crossing near the guard band, t rounded to ½ and the
+// crossing landed at the viewport's centre (half a covering triangle was lost).
+Quad wide_crossing(const ClipPlane& plane, const glm::dvec4& a, const glm::dvec4& b, Quad da, Quad db, int i) {
+    Quad sum = Quad(plane.offset) * (Quad(b[i]) - Quad(a[i]));
+    for (int j = 0; j < 4; ++j)
+        if (j != i && plane.normal[j] != 0.0)
+            sum += Quad(plane.normal[j]) * (Quad(a[j]) * Quad(b[i]) - Quad(b[j]) * Quad(a[i]));
+    return sum / (da - db);
+}
 
 // The point where edge (a, b) crosses the plane, always computed from the endpoint nearer the
 // plane (on a tie, the lexicographically smaller) so that (a, b) and (b, a) give the same bits.
@@ -48,7 +65,8 @@ using Quad = long double;
 // double and rounded once: an endpoint 10^15 px away has a double ulp of 1/8 px, and
 // a + t·(b − a) in double would move the crossing that far off the edge's line (stress suite,
 // case 3); the crossing itself lies near the guard band, where double is ample. Endpoints beyond
-// kWideCrossingRatio take Quad throughout, the distances included (exact products of doubles).
+// kWideCrossingRatio take Quad throughout, the distances included (exact products of doubles),
+// and the position from the edge's 2×2 minors (wide_crossing).
 ClipVertex intersect(const ClipPlane& plane, const ClipVertex& a, double da, const ClipVertex& b, double db) {
     const double off_a = std::fabs(da), off_b = std::fabs(db);  // distances from the plane
     if (off_b < off_a || (off_b == off_a && lexicographically_less(b.position, a.position)))
@@ -72,7 +90,10 @@ ClipVertex intersect(const ClipPlane& plane, const ClipVertex& a, double da, con
             return static_cast<double>(Wide(from) + t * (Wide(to) - Wide(from)));
         };
         ClipVertex out;
-        for (int i = 0; i < 4; ++i) out.position[i] = along(a.position[i], b.position[i]);
+        for (int i = 0; i < 4; ++i)
+            out.position[i] = wide && wa != wb ? static_cast<double>(wide_crossing(plane, a.position, b.position,
+                                                                                   Quad(wa), Quad(wb), i))
+                                               : along(a.position[i], b.position[i]);
         for (int i = 0; i < 3; ++i) out.weights[i] = along(a.weights[i], b.weights[i]);
         return out;
     };
@@ -81,21 +102,64 @@ ClipVertex intersect(const ClipPlane& plane, const ClipVertex& a, double da, con
 
 }  // namespace
 
-bool projects_to_a_line(const std::array<glm::dvec4, 3>& p) {
-    // det[x y w] by the first column, and the same sum over absolute values (the permanent): the
-    // evaluation's rounding error is at most a few ulps of the permanent.
-    const double m0 = p[1].y * p[2].w - p[1].w * p[2].y, n0 = std::fabs(p[1].y * p[2].w) + std::fabs(p[1].w * p[2].y);
-    const double m1 = p[1].x * p[2].w - p[1].w * p[2].x, n1 = std::fabs(p[1].x * p[2].w) + std::fabs(p[1].w * p[2].x);
-    const double m2 = p[1].x * p[2].y - p[1].y * p[2].x, n2 = std::fabs(p[1].x * p[2].y) + std::fabs(p[1].y * p[2].x);
-    const double det = p[0].x * m0 - p[0].y * m1 + p[0].w * m2;
-    const double permanent = std::fabs(p[0].x) * n0 + std::fabs(p[0].y) * n1 + std::fabs(p[0].w) * n2;
-    return std::fabs(det) <= kProjectedAreaRoundingUlps * std::numeric_limits<double>::epsilon() * permanent;
+namespace {
+
+// det[x y w] by the first column, and the same sum over absolute values (the permanent), in T:
+// the evaluation's rounding error is at most a few ulps of T of the permanent. (In Quad, each
+// 2×2 minor is a difference of exact products.)
+template <class T>
+bool determinant_below_rounding(const std::array<glm::dvec3, 3>& p) {
+    const auto minor = [&](int i, int j, T& bound) {
+        const T a = T(p[1][i]) * T(p[2][j]), b = T(p[1][j]) * T(p[2][i]);
+        bound = (a < 0 ? -a : a) + (b < 0 ? -b : b);
+        return a - b;
+    };
+    T n0, n1, n2;
+    const T m0 = minor(1, 2, n0), m1 = minor(0, 2, n1), m2 = minor(0, 1, n2);
+    const T det = T(p[0].x) * m0 - T(p[0].y) * m1 + T(p[0].z) * m2;
+    const T permanent = T(std::fabs(p[0].x)) * n0 + T(std::fabs(p[0].y)) * n1 + T(std::fabs(p[0].z)) * n2;
+    const T epsilon = std::is_same_v<T, double> ? T(std::numeric_limits<double>::epsilon()) : T(kQuadEpsilon);
+    return (det < 0 ? -det : det) <= T(kProjectedAreaRoundingUlps) * epsilon * permanent;
 }
 
-ClipOutcome clip_triangle(const std::array<glm::dvec4, 3>& p, const std::array<std::uint8_t, 3>& outcodes,
+}  // namespace
+
+bool projects_to_a_line(const std::array<glm::dvec4, 3>& clip) {
+    // Each vertex scaled by the power of two that brings its largest |x|, |y|, |w| into [1, 2):
+    // both sides of the test scale alike with a vertex, and the products then neither overflow
+    // nor vanish (vertices 10^160 × w out made the determinant infinite, and the triangle was
+    // dropped as degenerate).
+    std::array<glm::dvec3, 3> p;
+    for (int k = 0; k < 3; ++k) {
+        const glm::dvec3 v(clip[k].x, clip[k].y, clip[k].w);
+        const double largest = std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)});
+        const int exponent = largest > 0.0 ? std::ilogb(largest) : 0;
+        p[k] = {std::ldexp(v.x, -exponent), std::ldexp(v.y, -exponent), std::ldexp(v.z, -exponent)};
+    }
+    // What double cannot tell from a line, Quad looks at again: a sliver 10^-17 of its extent
+    // thick, with vertices 10^152 px out, still covers half the image (binary128 resolves about
+    // 10^-32 of the permanent; thinner ones count as lines).
+    return determinant_below_rounding<double>(p) && determinant_below_rounding<Quad>(p);
+}
+
+ClipOutcome clip_triangle(const std::array<glm::dvec4, 3>& clip, const std::array<std::uint8_t, 3>& outcodes,
                           const ClipVolume& volume, ClipPolygon& out) {
     if ((outcodes[0] | outcodes[1] | outcodes[2]) == 0) return ClipOutcome::inside;
-    if ((outcodes[0] & outcodes[1] & outcodes[2]) != 0) return ClipOutcome::outside;
+    // A triangle whose |w| all lie below kTinyClipScale (within 10^-20 of the eye, or from a
+    // model matrix that scales w down) is clipped scaled up by a power of two: the plane
+    // w ≥ kMinClipW is absolute and cut all of it away. One positive scale for all three vertices
+    // leaves its projection, depth and perspective-correct weights as they were.
+    std::array<glm::dvec4, 3> p = clip;
+    std::array<std::uint8_t, 3> codes = outcodes;
+    const double largest = std::max({std::fabs(clip[0].w), std::fabs(clip[1].w), std::fabs(clip[2].w)});
+    if (largest > 0.0 && largest < kTinyClipScale) {
+        const int exponent = std::ilogb(largest);
+        for (int k = 0; k < 3; ++k) {
+            for (int i = 0; i < 4; ++i) p[k][i] = std::ldexp(clip[k][i], -exponent);
+            codes[k] = outcode(p[k], volume);
+        }
+    }
+    if ((codes[0] & codes[1] & codes[2]) != 0) return ClipOutcome::outside;
 
     // Sutherland–Hodgman, one plane at a time, ping-ponging between two polygons.
     ClipPolygon scratch;

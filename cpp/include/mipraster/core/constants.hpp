@@ -75,6 +75,12 @@ inline constexpr std::size_t kStreamedSetupBytes = std::size_t{8} << 20;
 /// is far above it; it matters only for degenerate user matrices).
 inline constexpr double kMinClipW = 1e-30;
 
+/// A clipped triangle whose |w| all lie below this is scaled up before clipping (clip.cpp), so
+/// that the absolute kMinClipW does not cut it away; far above kMinClipW, far below the w of a
+/// sane camera's geometry.
+inline constexpr double kTinyClipScale = 0x1p-64;
+static_assert(kTinyClipScale > 1e6 * kMinClipW, "a tiny triangle's w stays clear of kMinClipW once scaled");
+
 /// An edge whose endpoints lie farther out than this many times the smaller |w| of the two
 /// crosses a clip plane in binary128 (clip.cpp): their distances from the plane, in double, are
 /// off by up to 2⁻⁵³ of their size, which moves a long-double crossing by up to 2⁻²⁷ in x/w and
