@@ -386,6 +386,51 @@ def test_bad_face_indices_are_errors_naming_file_and_line(tmp_path, text, messag
         mr.load_scene(path)
 
 
+@pytest.mark.parametrize("line, message", [
+    ("v -1", r"a vertex needs 3 coordinates \(x y z\), got 1"),
+    ("v", r"a vertex needs 3 coordinates \(x y z\), got 0"),
+    ("v 0 0", r"a vertex needs 3 coordinates \(x y z\), got 2"),
+    ("v 0 0 0 1 0", r"a vertex is x y z, x y z w or x y z r g b \(with a colour\), got 5 numbers"),
+    ("v 0 0 0 1 0 0 1", r"a vertex is x y z, x y z w or x y z r g b \(with a colour\), got 7 numbers"),
+    ("vn 1", r"a normal needs 3 coordinates \(i j k\), got 1"),
+    ("vn 0 0 1 0", r"a normal needs 3 coordinates \(i j k\), got 4"),
+    ("vt", r"a texture coordinate is u \[v \[w\]\] \(1 to 3 numbers\), got 0"),
+    ("vt 0 0 0 0", r"a texture coordinate is u \[v \[w\]\] \(1 to 3 numbers\), got 4"),
+])
+def test_vertex_lines_with_a_wrong_count_of_numbers_are_errors_naming_the_line(tmp_path, line, message):
+    # tinyobjloader filled missing numbers with 0 and dropped extra ones: 'v -1' loaded as (-1, 0, 0),
+    # a bare 'v' was not counted (the faces after it took the wrong vertices).
+    path = tmp_path / "short.obj"
+    path.write_text(f"v -1 -1 0\nv 1 -1 0\nv 0 1 0\n{line}\nf 1 2 3\n")
+    with pytest.raises(OSError, match=rf"short\.obj: line 4 \('{line}'\): {message}"):
+        mr.load_scene(path)
+
+
+def test_vertex_lines_of_every_legal_length_load(tmp_path):
+    # v x y z w (w ignored); vt u (v = 0, as the OBJ spec has it) and vt u v w (w ignored).
+    path = tmp_path / "forms.obj"
+    path.write_text("v -1 -1 0 1\nv 1 -1 0 0.5\nv 0 1 0\nvt 0.25\nvt 0.5 0.75 0\nvn 0 0 1\n"
+                    "f 1/1/1 2/2/1 3/1/1\n")
+    scene, messages = load_quiet(path)
+    assert messages == []
+    mesh = scene.draws[0].mesh
+    np.testing.assert_array_equal(mesh.positions, QUAD_V[[0, 1]].tolist() + [[0, 1, 0]])
+    np.testing.assert_array_equal(mesh.uvs, [[0.25, 1.0], [0.5, 0.25], [0.25, 1.0]])  # 1 − v flips v
+    np.testing.assert_array_equal(mesh.normals, [[0, 0, 1]] * 3)
+
+
+def test_vertex_colours_outside_0_1_warn_naming_the_first_line(tmp_path):
+    # The 0-255 convention some exporters use was drawn as colour 255, without a word.
+    path = tmp_path / "colours.obj"
+    path.write_text("v -1 -1 0 0 0 1\nv 1 -1 0 255 0 0\nv 0 1 0 0 128 0\nf 1 2 3\n")
+    scene, messages = load_quiet(path)
+    assert messages == [f"{path}: line 2: vertex colour 255 is outside [0, 1] (2 value(s) in all); colours are "
+                        "expected in [0, 1] (0-255 ones are not rescaled), they are drawn as written"]
+    np.testing.assert_array_equal(scene.draws[0].mesh.colors, [[0, 0, 1, 1], [255, 0, 0, 1], [0, 128, 0, 1]])
+    path.write_text("v -1 -1 0 0 0 1\nv 1 -1 0 1 0 0\nv 0 1 0 0 0.5 0\nf 1 2 3\n")
+    assert load_quiet(path)[1] == []
+
+
 @pytest.mark.parametrize("kd", ["1e39 0 0", "0.5", "0 0 -4e38"])
 def test_kd_beyond_float_is_an_error_naming_the_mtl_line(tmp_path, kd):
     # (finite as a double, inf as the draw's float colour: the render refused "draws[0].color")

@@ -232,7 +232,8 @@ ObjCorner parse_corner(std::string_view word, const std::size_t (&counts)[3], lo
 }
 
 /// Reads and checks an OBJ file (every number of the v / vt / vn lines must parse completely and
-/// be a finite float; every index of the f lines must be an integer that fits an int and refer to
+/// be a finite float, and each line have as many as its kind allows; vertex colours outside [0, 1]
+/// give a warning; every index of the f lines must be an integer that fits an int and refer to
 /// an element of the file) into the text tinyobjloader reads: comments, continuations and a byte
 /// order mark resolved; mtllib lines taken out (the loader reads the MTL files); "usemtl NAME"
 /// written "usemtl <id>"; l / p elements and faces of fewer than three corners dropped (with a
@@ -247,6 +248,8 @@ ObjSource read_obj_source(const std::string& path, std::vector<std::string>& war
     std::size_t counts[3] = {0, 0, 0}, largest_line[3] = {0, 0, 0}, faces = 0;
     long long largest[3] = {0, 0, 0};
     std::size_t not_drawn = 0, short_faces = 0, first_short = 0;
+    std::size_t coloured = 0, colours_outside = 0, first_outside = 0;  // vertices with r g b; values not in [0, 1]
+    std::string first_outside_value;
     std::vector<ObjCorner> corners;
     for_each_line(bytes, [&](std::size_t number, std::string_view line, int joined) {
         const auto bad = [&](const std::string& what) { fail(path, line_what(number, line) + ": " + what); };
@@ -255,12 +258,35 @@ ObjSource read_obj_source(const std::string& path, std::vector<std::string>& war
         const int kind = keyword == "v" ? 0 : keyword == "vt" ? 1 : keyword == "vn" ? 2 : -1;
         if (kind >= 0) {
             double value = 0.0;
+            std::size_t numbers = 0;
+            std::string_view words[6];
             for (std::string_view word = next_word(rest); !word.empty(); word = next_word(rest)) {
                 if (!parse_number(word, value) || !std::isfinite(value))
                     bad("'" + std::string(word) + "' is not a finite number");
                 // (tinyobjloader keeps floats: 1e39 became inf.)
                 if (std::fabs(value) > std::numeric_limits<float>::max())
                     bad("'" + std::string(word) + "' is beyond float's range");
+                if (numbers < 6) words[numbers] = word;
+                ++numbers;
+            }
+            // tinyobjloader fills missing numbers with 0 and drops extra ones, silently: a vertex is
+            // x y z [w] or x y z r g b (w, a rational curve's weight, is ignored); a texture coordinate
+            // u [v [w]] (v defaults to 0, as the OBJ spec says; w is ignored); a normal i j k.
+            const std::string got = ", got " + std::to_string(numbers);
+            if (kind == 0 && numbers < 3) bad("a vertex needs 3 coordinates (x y z)" + got);
+            if (kind == 0 && numbers != 3 && numbers != 4 && numbers != 6)
+                bad("a vertex is x y z, x y z w or x y z r g b (with a colour)" + got + " numbers");
+            if (kind == 1 && (numbers < 1 || numbers > 3))
+                bad("a texture coordinate is u [v [w]] (1 to 3 numbers)" + got);
+            if (kind == 2 && numbers != 3) bad("a normal needs 3 coordinates (i j k)" + got);
+            if (kind == 0 && numbers == 6) {
+                ++coloured;
+                // Colours are in [0, 1]: 0-255 ones (some exporters') are drawn as written, with a warning.
+                for (int c = 3; c < 6; ++c)
+                    if (parse_number(words[c], value) && !(value >= 0.0 && value <= 1.0) && colours_outside++ == 0) {
+                        first_outside = number;
+                        first_outside_value = std::string(words[c]);
+                    }
             }
             ++counts[kind];
             src.text.append(line);
@@ -307,6 +333,11 @@ ObjSource read_obj_source(const std::string& path, std::vector<std::string>& war
                            " is the first)");
     if (not_drawn > 0)
         warnings.push_back(path + ": " + std::to_string(not_drawn) + " line (l) or point (p) element(s) not drawn");
+    if (colours_outside > 0 && coloured == counts[0])  // (colours are read only when every vertex has one)
+        warnings.push_back(path + ": line " + std::to_string(first_outside) + ": vertex colour " + first_outside_value +
+                           " is outside [0, 1] (" + std::to_string(colours_outside) +
+                           " value(s) in all); colours are expected in [0, 1] (0-255 ones are not rescaled), "
+                           "they are drawn as written");
     return src;
 }
 
