@@ -233,6 +233,112 @@ def test_gltf_of_another_version_is_an_error_naming_it(tmp_path, asset, message)
         mr.load_scene(path)
 
 
+def glb_of(doc, version=2):
+    """A .glb file of `doc` (its buffer stays a data URI): the header and one JSON chunk."""
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    return struct.pack("<4sIII4s", b"glTF", version, 20 + len(text), len(text), b"JSON") + text
+
+
+@pytest.mark.parametrize("version, message", [
+    (2, None),
+    (1, r"GLB version 1 is not supported \(glTF 2\.0 needs GLB version 2\)"),
+    (3, r"GLB version 3 is not supported"),
+])
+def test_glb_of_another_version_is_an_error_naming_it(tmp_path, version, message):
+    # (a version 1 header was read as version 2)
+    doc = json.loads(write_gltf(tmp_path / "tri.gltf").read_text())
+    path = tmp_path / "versioned.glb"
+    path.write_bytes(glb_of(doc, version))
+    if message is None:
+        assert len(mr.load_scene(path)[0].draws) == 1
+        return
+    with pytest.raises(OSError, match=r"versioned\.glb: " + message):
+        mr.load_scene(path)
+
+
+@pytest.mark.parametrize("indices", [-5, -2])
+@pytest.mark.parametrize("suffix", [".gltf", ".glb"])
+def test_gltf_indices_that_name_no_accessor_are_an_error_naming_the_primitive(tmp_path, indices, suffix):
+    # tinygltf does not check negative indices (those beyond the last accessor it names itself): the
+    # primitive was drawn unindexed. (A written -1 or 1.5 it reads as "no indices", as if the key
+    # were missing: that one it cannot tell.)
+    doc = json.loads(write_gltf(tmp_path / "tri.gltf").read_text())
+    doc["meshes"][0]["primitives"][0]["indices"] = indices
+    path = tmp_path / f"idx{suffix}"
+    if suffix == ".glb":
+        path.write_bytes(glb_of(doc))
+    else:
+        path.write_text(json.dumps(doc))
+    with pytest.raises(OSError, match=rf"idx{re.escape(suffix)}: meshes\[0\]\.primitives\[0\] indices: "
+                                      rf"accessor {re.escape(str(indices))} does not exist \(the file has 2\)"):
+        mr.load_scene(path)
+
+
+def test_gltf_primitive_without_indices_still_loads_unindexed(tmp_path):
+    path = write_gltf(tmp_path / "tri.gltf")
+    doc = json.loads(path.read_text())
+    del doc["meshes"][0]["primitives"][0]["indices"]
+    path.write_text(json.dumps(doc))
+    scene, _ = mr.load_scene(path)
+    np.testing.assert_array_equal(scene.draws[0].mesh.triangles, [[0, 1, 2]])
+
+
+@pytest.mark.parametrize("roots, message", [
+    ([0, 1], None),
+    ([0, 1, 2], r"node 2 is listed in scenes\[0\]\.nodes and as a child of node 0 \(a scene lists only root nodes\)"),
+    ([0, 1, 0], r"node 0 is listed twice in scenes\[0\]\.nodes"),
+])
+def test_gltf_scene_node_that_is_no_root_is_an_error_naming_it(tmp_path, roots, message):
+    # (such a node was drawn once as a root and once as its parent's child)
+    path = write_gltf(tmp_path / "roots.gltf")
+    doc = json.loads(path.read_text())
+    doc["nodes"] = [{"mesh": 0, "children": [2]}, doc["nodes"][1], {"mesh": 0, "translation": [0.5, 0, 0]}]
+    doc["scenes"] = [{"nodes": roots}]
+    path.write_text(json.dumps(doc))
+    if message is None:
+        assert len(mr.load_scene(path)[0].draws) == 2
+        return
+    with pytest.raises(OSError, match=r"roots\.gltf: " + message):
+        mr.load_scene(path)
+
+
+def test_gltf_unknown_alpha_mode_warns_naming_the_material_and_draws_opaque(tmp_path):
+    # (it was drawn OPAQUE without a word, like the bad wrapS the loader warns about)
+    path = write_gltf(tmp_path / "alpha.gltf", color=(1.0, 0.0, 0.0, 0.5))
+    doc = json.loads(path.read_text())
+    doc["materials"][0]["alphaMode"] = "WEIRD"
+    path.write_text(json.dumps(doc))
+    scene, messages = load_warning_texts(path)
+    assert messages == [f"{path}: material materials[0]: alphaMode 'WEIRD' is not OPAQUE, MASK or BLEND; using OPAQUE"]
+    (d,) = scene.draws
+    assert d.blend == "replace" and d.alpha_cutoff is None and d.color == (1.0, 0.0, 0.0, 1.0)
+
+
+@pytest.mark.parametrize("value, written", [(1e30, "1e+30"), (-5.0, "-5"), (1.0, None)])
+def test_gltf_color_0_outside_0_1_is_clamped_with_a_warning_naming_the_primitive(tmp_path, value, written):
+    # (1e30 was drawn as it was, far beyond white, and -5 as a negative colour)
+    path = write_gltf(tmp_path / "col.gltf")
+    doc = json.loads(path.read_text())
+    buf = base64.b64decode(doc["buffers"][0]["uri"].split(",")[1])
+    colours = struct.pack("<12f", value, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1)
+    doc["buffers"] = [{"byteLength": len(buf) + 48,
+                       "uri": "data:application/octet-stream;base64," + base64.b64encode(buf + colours).decode()}]
+    doc["bufferViews"].append({"buffer": 0, "byteOffset": len(buf), "byteLength": 48})
+    doc["accessors"].append({"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"})
+    doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = 2
+    path.write_text(json.dumps(doc))
+    scene, messages = load_warning_texts(path)
+    colors = scene.draws[0].mesh.colors
+    np.testing.assert_array_equal(colors[1:], [[0, 1, 0, 1], [0, 0, 1, 1]])
+    np.testing.assert_array_equal(colors[0], [min(max(value, 0), 1), 0, 0, 1])
+    if written is None:
+        assert messages == []
+        return
+    assert messages == [f"{path}: meshes[0].primitives[0] COLOR_0 (accessor 2): 1 value(s) outside [0, 1], the "
+                        f"spec's range (vertex 0 is ({written}, 0, 0, 1)); clamped to [0, 1]"]
+
+
 @pytest.mark.parametrize("factor", [[1e39, 0, 0, 1], [1e30, 1, 1, 1e30]])
 def test_gltf_base_color_beyond_float_is_an_error_naming_the_material(tmp_path, factor):
     # a component past float's range, or (BLEND) a colour times alpha past it

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <optional>
@@ -431,6 +432,8 @@ struct GltfLoader {
         if (f.size() != 4) fail(path, name + ": baseColorFactor must have 4 numbers");
         for (double v : f)
             if (!std::isfinite(v)) fail(path, name + ": baseColorFactor is not finite");
+        if (mat.alphaMode != "OPAQUE" && mat.alphaMode != "MASK" && mat.alphaMode != "BLEND")
+            warn_once(name + ": alphaMode '" + mat.alphaMode + "' is not OPAQUE, MASK or BLEND; using OPAQUE");
         const bool blend = mat.alphaMode == "BLEND";
         // MASK: alpha-tested against alphaCutoff (tinygltf gives the spec's default, 0.5, when the
         // file has none), then drawn opaque with replace blending.
@@ -641,7 +644,7 @@ struct GltfLoader {
     std::vector<std::uint32_t> vertex_sequence(const tinygltf::Primitive& prim, std::size_t vertex_count,
                                                const std::string& what) const {
         std::vector<std::uint32_t> sequence;
-        if (prim.indices < 0) {
+        if (prim.indices == -1) {  // (tinygltf's "none", a written -1 too; other negatives are named below)
             sequence.resize(vertex_count);
             for (std::size_t i = 0; i < vertex_count; ++i) sequence[i] = static_cast<std::uint32_t>(i);
             return sequence;
@@ -924,6 +927,24 @@ struct GltfLoader {
             for (std::size_t i = 0; i < col.count(); ++i)
                 colours[i] = glm::dvec4(col.get(i, 0), col.get(i, 1), col.get(i, 2),
                                         col.components() == 4 ? col.get(i, 3) : 1.0);
+            // The spec's colours lie in [0, 1] (normalized integers always do): float values beyond
+            // are clamped, with a warning (a NaN is left to mesh->validate, which names it).
+            std::size_t outside = 0, first = 0;
+            for (std::size_t i = 0; i < colours.size(); ++i)
+                for (int c = 0; c < 4; ++c)
+                    if (colours[i][c] < 0.0 || colours[i][c] > 1.0) {
+                        if (outside++ == 0) first = i;
+                        colours[i][c] = std::clamp(colours[i][c], 0.0, 1.0);
+                    }
+            if (outside > 0) {
+                const glm::dvec4 raw(col.get(first, 0), col.get(first, 1), col.get(first, 2),
+                                     col.components() == 4 ? col.get(first, 3) : 1.0);
+                std::ostringstream value;
+                value << "(" << raw.r << ", " << raw.g << ", " << raw.b << ", " << raw.a << ")";
+                warn_once(col.what() + ": " + std::to_string(outside) +
+                          " value(s) outside [0, 1], the spec's range (vertex " + std::to_string(first) + " is " +
+                          value.str() + "); clamped to [0, 1]");
+            }
             if (morph(prim, weights, "COLOR_0", colours, what))
                 for (glm::dvec4& c : colours) c = glm::clamp(c, 0.0, 1.0);
             const bool alpha = material_uses_alpha(prim.material);
@@ -1290,6 +1311,20 @@ void check_required_extensions(const tinygltf::Model& model, const std::string& 
     }
 }
 
+/// A .glb file's version (the header's second word) must be 2: version 1 (glTF 1.0's
+/// KHR_binary_glTF) lays its chunks out otherwise, and tinygltf read it as version 2.
+void check_glb_version(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    unsigned char header[8] = {};
+    if (!in.read(reinterpret_cast<char*>(header), sizeof header) || std::memcmp(header, "glTF", 4) != 0)
+        return;  // (tinygltf names a short file or a wrong magic)
+    const std::uint32_t version = static_cast<std::uint32_t>(header[4]) | static_cast<std::uint32_t>(header[5]) << 8 |
+                                  static_cast<std::uint32_t>(header[6]) << 16 |
+                                  static_cast<std::uint32_t>(header[7]) << 24;
+    if (version != 2)
+        fail(path, "GLB version " + std::to_string(version) + " is not supported (glTF 2.0 needs GLB version 2)");
+}
+
 // tinygltf's FileExists callback, for regular files only: a buffer whose uri named a directory
 // was opened and its "size" allocated (std::bad_alloc).
 bool regular_file_exists(const std::string& path, void*) {
@@ -1305,6 +1340,7 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
                            tinygltf::WriteWholeFile, nullptr});
     EmbeddedImages embedded;
     loader.SetImageLoader(keep_data_uri_image, &embedded);
+    if (binary) check_glb_version(path);
     tinygltf::Model model;
     std::string err, warn;
     bool ok = false;
@@ -1344,6 +1380,17 @@ LoadedScene load_gltf(const std::string& path, bool binary) {
         if (static_cast<std::size_t>(s) >= model.scenes.size())
             fail(path, "default scene " + std::to_string(s) + " does not exist");
         roots = model.scenes[s].nodes;
+        // A scene's nodes are roots, each listed once: a child or a repeat would be drawn twice.
+        const std::string scene_what = "scenes[" + std::to_string(s) + "].nodes";
+        std::set<int> listed;
+        for (int r : roots) {
+            if (r < 0 || static_cast<std::size_t>(r) >= model.nodes.size()) continue;  // (add_node names it)
+            if (!listed.insert(r).second)
+                fail(path, "node " + std::to_string(r) + " is listed twice in " + scene_what);
+            if (const int parent = g.parents[static_cast<std::size_t>(r)]; parent >= 0)
+                fail(path, "node " + std::to_string(r) + " is listed in " + scene_what + " and as a child of node " +
+                               std::to_string(parent) + " (a scene lists only root nodes)");
+        }
     } else {
         std::vector<bool> is_child(model.nodes.size(), false);
         for (const auto& n : model.nodes)
