@@ -6,6 +6,7 @@ read or written, never by ``import mipraster``. sRGB encoding lives in ``miprast
 from __future__ import annotations
 
 import errno
+import math
 import os
 from types import ModuleType
 from typing import Any, Union
@@ -59,6 +60,21 @@ def _float_image(image: Any, name: str) -> np.ndarray:
     return a
 
 
+def _check_finite_pixels(a: np.ndarray, what: str) -> None:
+    """ValueError naming the first NaN or ±inf value of an (H, W[, C]) image by pixel (x, y) and
+    channel: an 8- or 16-bit code has no value for it (it became 0 or the clamp limit, a silent
+    wrong image). ``what`` starts the message."""
+    if a.dtype.kind != "f":
+        return
+    bad = ~np.isfinite(a)
+    if not bad.any():
+        return
+    index = tuple(int(i) for i in np.argwhere(bad)[0])
+    y, x, c = index if len(index) == 3 else (*index, 0)
+    raise ValueError(f"{what}: pixel (x={x}, y={y}) channel {c} is {a[index]} (image[{', '.join(map(str, index))}]); "
+                     "8- and 16-bit codes need finite values (write .exr to keep NaN and inf)")
+
+
 def read_image(path: PathLike, srgb: bool = True) -> np.ndarray:
     """Reads an image file into ``(H, W, 4)`` float32, linear premultiplied RGBA.
 
@@ -93,14 +109,17 @@ def write_image(path: PathLike, image: Any, bits: int = 8) -> None:
 
     Raises:
         TypeError: a non-float image.
-        ValueError: a wrong shape, a finite value beyond float32's range, an unsupported
-            extension, or bits other than 8 or 16 (or than 8 for an EXR).
+        ValueError: a wrong shape, a finite value beyond float32's range, NaN or ±inf in a PNG
+            (naming the first pixel and channel; an EXR keeps them), an unsupported extension, or
+            bits other than 8 or 16 (or than 8 for an EXR).
         OSError: the file cannot be written (the message names the path; ``.filename`` is set).
     """
     p = _path(path)
     if isinstance(bits, bool) or not isinstance(bits, (int, np.integer)) or bits not in (8, 16):
         raise ValueError(f"write_image: bits={bits!r}: a PNG has 8 or 16 bits per channel")
     a = _float_image(image, "image")
+    if os.path.splitext(p)[1].lower() == ".png":  # (the C++ side checks too: this names the array index)
+        _check_finite_pixels(a, f"write_image: cannot write {p!r}")
     _image_module().write_image(p, np.ascontiguousarray(a, dtype=np.float32), int(bits))
 
 
@@ -108,24 +127,50 @@ def to_srgb8(image: Any) -> np.ndarray:
     """Linear premultiplied ``(H, W, 4)`` float (or linear ``(H, W, 3)``, ``(H, W)``) → ``(H, W, 4)`` uint8.
 
     Colour is un-premultiplied and sRGB-encoded (linear 0.5 → 188), alpha stored linearly: the
-    bytes a PNG written by :func:`write_image` holds.
+    bytes a PNG written by :func:`write_image` holds. ValueError for NaN or ±inf, naming the
+    first pixel and channel.
     """
     a = _float_image(image, "image")
+    _check_finite_pixels(a, "to_srgb8")
     return _core.to_srgb8(np.ascontiguousarray(a, dtype=np.float32))
 
 
 # The sRGB transfer functions, element by element (a number gives a number, an array an array of
-# float32; uint8 for linear_to_srgb8). Checked here: the bindings read None as 0.
+# float32; uint8 for linear_to_srgb8). Checked here: the bindings read None as 0, and the C++
+# functions clamp NaN to 0.
+def _keep_nan(values: np.ndarray, out: Any) -> Any:
+    """``out`` (the C++ function of ``values``) with NaN where ``values`` holds NaN: NaN in, NaN out."""
+    if values.dtype.kind != "f":
+        return out
+    nan = np.isnan(values)
+    if not nan.any():
+        return out
+    if values.ndim == 0:
+        return math.nan
+    out = np.array(out, dtype=np.float32)
+    out[nan] = np.nan
+    return out
+
+
 def srgb_to_linear(encoded: Any) -> Any:
-    """sRGB-encoded values (0…1) to linear; TypeError for anything but real numbers."""
-    return _core.srgb_to_linear(_checks.real_array(encoded, "encoded"))
+    """sRGB-encoded values (0…1) to linear (NaN stays NaN); TypeError for anything but real numbers."""
+    a = _checks.real_array(encoded, "encoded")
+    return _keep_nan(a, _core.srgb_to_linear(a))
 
 
 def linear_to_srgb(linear: Any) -> Any:
-    """Linear values to sRGB-encoded ones (0…1); TypeError for anything but real numbers."""
-    return _core.linear_to_srgb(_checks.real_array(linear, "linear"))
+    """Linear values to sRGB-encoded ones (0…1; NaN stays NaN); TypeError for anything but real numbers."""
+    a = _checks.real_array(linear, "linear")
+    return _keep_nan(a, _core.linear_to_srgb(a))
 
 
 def linear_to_srgb8(linear: Any) -> Any:
-    """Linear values to sRGB8 codes (0…255, rounded); TypeError for anything but real numbers."""
-    return _core.linear_to_srgb8(_checks.real_array(linear, "linear"))
+    """Linear values to sRGB8 codes (0…255, rounded); TypeError for anything but real numbers,
+    ValueError naming the first NaN or ±inf (a code has no value for it)."""
+    a = _checks.real_array(linear, "linear")
+    if a.dtype.kind == "f" and not np.isfinite(a).all():
+        if a.ndim == 0:
+            raise ValueError(f"linear is {a.item()}; an sRGB8 code needs a finite number")
+        index = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
+        raise ValueError(f"linear[{', '.join(map(str, index))}] is {a[index]}; an sRGB8 code needs a finite number")
+    return _core.linear_to_srgb8(a)

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -212,6 +213,39 @@ TEST(ImageIo, MalformedImageThrows) {
     const std::string path = output_path("short.exr");
     const std::string message = thrown_message([&] { mr::write_image(path, short_pixels); });
     EXPECT_NE(message.find(path), std::string::npos) << message;
+}
+
+TEST(ImageIo, NonFinitePixelInPngThrowsNamingItAndExrKeepsIt) {
+    // A PNG code has no NaN (written as 0) and ±inf only the clamp limit: a silent wrong image.
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    for (const float bad : {nan, inf, -inf}) {
+        for (const int channels : {1, 3, 4}) {
+            for (const int bits : {8, 16}) {
+                mr::Image img(4, 3, channels);
+                img.at(2, 1, channels - 1) = bad;
+                const std::string path = output_path("non_finite.png");
+                fs::remove(path);
+                mr::ImageWriteOptions options;
+                options.png_bits = bits;
+                EXPECT_THROW(mr::write_image(path, img, options), std::invalid_argument);
+                const std::string message = thrown_message([&] { mr::write_image(path, img, options); });
+                const std::string where = "pixel (x=2, y=1) channel " + std::to_string(channels - 1) + " is " +
+                                          (std::isnan(bad) ? "nan" : bad > 0 ? "inf" : "-inf");
+                EXPECT_NE(message.find(where), std::string::npos) << message;
+                EXPECT_NE(message.find(path), std::string::npos) << message;
+                EXPECT_FALSE(fs::exists(path));
+            }
+        }
+    }
+    // An EXR is float: NaN and inf are stored as they are.
+    mr::Image img(4, 3, 4);
+    img.at(2, 1, 0) = nan;
+    img.at(3, 2, 1) = inf;
+    const std::string path = output_path("non_finite.exr");
+    mr::write_image(path, img);
+    const mr::Image back = mr::read_image(path);
+    EXPECT_TRUE(std::isnan(back.at(2, 1, 0)));
+    EXPECT_EQ(back.at(3, 2, 1), inf);
 }
 
 TEST(ImageIo, UnwritableLocationThrowsNamingPath) {

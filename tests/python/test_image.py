@@ -1,4 +1,5 @@
 """Image files and sRGB: RenderResult.save, read_image / write_image, to_srgb8, and their errors."""
+import math
 import os
 
 import numpy as np
@@ -207,15 +208,59 @@ def test_write_image_refuses_bad_arrays(tmp_path, image, error, words):
         assert w in str(e.value)
 
 
-@pytest.mark.parametrize("suffix", [".png", ".exr"])
-def test_write_image_keeps_nan_and_inf_of_float64_images(tmp_path, suffix):
-    # (check_fits_float32 refuses finite values only: non-finite ones are the caller's data)
+def test_write_image_exr_keeps_nan_and_inf_of_float64_images(tmp_path):
+    # (check_fits_float32 refuses finite values only: an EXR stores non-finite ones as they are)
     image = np.full((2, 2, 4), 0.5)
     image[0, 0, 0], image[0, 1, 1] = np.nan, np.inf
-    mr.write_image(tmp_path / f"x{suffix}", image)
-    if suffix == ".exr":
-        back = mr.read_image(tmp_path / "x.exr")
-        assert np.isnan(back[0, 0, 0]) and back[0, 1, 1] == np.inf
+    mr.write_image(tmp_path / "x.exr", image)
+    back = mr.read_image(tmp_path / "x.exr")
+    assert np.isnan(back[0, 0, 0]) and back[0, 1, 1] == np.inf
+
+
+@pytest.mark.parametrize("shape", [(3, 4), (3, 4, 1), (3, 4, 3), (3, 4, 4)])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+@pytest.mark.parametrize("bits", [8, 16])
+def test_write_png_refuses_nan_and_inf_naming_the_pixel(tmp_path, shape, bad, bits):
+    # A PNG code has no NaN: it was written as 0 (and inf as the clamp limit), a silent wrong image.
+    image = np.full(shape, 0.5, np.float32)
+    channel = shape[2] - 1 if len(shape) == 3 else 0
+    image[(2, 1, channel)[:len(shape)]] = bad
+    with pytest.raises(ValueError) as e:
+        mr.write_image(tmp_path / "x.png", image, bits=bits)
+    assert f"pixel (x=1, y=2) channel {channel} is {bad}" in str(e.value)
+    assert "x.png" in str(e.value) and ".exr" in str(e.value)
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_write_png_refuses_nan_in_the_cpp_module_too(tmp_path):
+    # The extension module's own check (the C++ API and the CLI write through it): ValueError
+    # naming the first non-finite pixel, not a PNG with 0 in its place.
+    from mipraster import _image
+
+    image = np.full((3, 4, 4), 0.5, np.float32)
+    image[1, 2, 3] = np.nan
+    with pytest.raises(ValueError, match=r"pixel \(x=2, y=1\) channel 3 is nan"):
+        _image.write_image(str(tmp_path / "x.png"), image, 8)
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_to_srgb8_and_transfer_functions_do_not_turn_nan_into_codes():
+    image = np.full((2, 3, 4), 0.5, np.float32)
+    image[1, 2, 0] = np.nan
+    with pytest.raises(ValueError, match=r"to_srgb8: pixel \(x=2, y=1\) channel 0 is nan"):
+        mr.to_srgb8(image)
+    image[1, 2, 0] = -np.inf
+    with pytest.raises(ValueError, match=r"channel 0 is -inf"):
+        mr.to_srgb8(image)
+    with pytest.raises(ValueError, match="linear is nan"):
+        mr.linear_to_srgb8(float("nan"))
+    with pytest.raises(ValueError, match=r"linear\[1\] is inf"):
+        mr.linear_to_srgb8([0.5, np.inf])
+    # Float to float: NaN in, NaN out (it was 0.0); the rest as before.
+    assert math.isnan(mr.srgb_to_linear(float("nan"))) and math.isnan(mr.linear_to_srgb(float("nan")))
+    out = mr.srgb_to_linear(np.array([0.5, np.nan, 1.0], np.float32))
+    assert out.dtype == np.float32 and np.isnan(out[1]) and out[2] == 1.0 and out[0] == mr.srgb_to_linear(0.5)
+    assert np.isnan(mr.linear_to_srgb([[np.nan, 0.5]])[0, 0])
 
 
 def test_bad_path_type():
@@ -313,12 +358,11 @@ def test_png_16_bits_grey_and_rgb(tmp_path, channels):
     # RGB is sRGB-encoded without alpha; one channel is plain grey data, round(clamp(v) · 65535).
     rng = np.random.default_rng(channels)
     image = rng.uniform(-0.1, 1.1, size=(5, 6, channels)).astype(np.float32)
-    image[0, 0, 0] = np.nan
     mr.write_image(tmp_path / "x.png", image, bits=16)
     codes = decode_png(tmp_path / "x.png")
     assert codes.shape == (5, 6, channels)
     if channels == 1:
-        want = np.round(np.clip(np.nan_to_num(image.astype(np.float64), nan=0.0), 0, 1) * 65535)
+        want = np.round(np.clip(image.astype(np.float64), 0, 1) * 65535)
     else:
         want = np.round(srgb_encode(image) * 65535)
     assert np.abs(codes - want).max() <= 1

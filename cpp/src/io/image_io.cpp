@@ -57,7 +57,26 @@ void check_image(const std::string& path, const Image& image) {
                                     std::to_string(expected));
 }
 
-// 1-channel PNG: plain grey, round(clamp(v, 0, 1) * max code); NaN → 0.
+// A PNG holds 8- or 16-bit codes of clamped values: NaN has none (the encoders map it to 0) and
+// ±inf only the clamp limit, a silent wrong image. Refused here, at write_image, naming the first
+// (the encoders themselves keep their clamping: to_srgb8 and grey_codes are total functions, and a
+// render never holds NaN). An EXR stores the floats as they are, NaN and inf included.
+void check_finite_for_png(const std::string& path, const Image& image) {
+    for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+        const float v = image.pixels[i];
+        if (std::isfinite(v)) continue;
+        const std::size_t channels = static_cast<std::size_t>(image.channels);
+        const std::size_t pixel = i / channels, width = static_cast<std::size_t>(image.width);
+        throw std::invalid_argument("write_image: cannot write '" + path + "': pixel (x=" +
+                                    std::to_string(pixel % width) + ", y=" + std::to_string(pixel / width) +
+                                    ") channel " + std::to_string(i % channels) + " is " +
+                                    (std::isnan(v) ? "nan" : v > 0.0f ? "inf" : "-inf") +
+                                    "; 8- and 16-bit codes need finite values (write .exr to keep NaN and inf)");
+    }
+}
+
+// 1-channel PNG: plain grey, round(clamp(v, 0, 1) * max code) (NaN → 0, though write_image has
+// refused non-finite values before this).
 template <typename Code>
 std::vector<Code> grey_codes(const Image& image) {
     std::vector<Code> out(image.pixels.size());
@@ -133,6 +152,7 @@ void write_image(const std::string& path, const Image& image, const ImageWriteOp
         return;
     }
 
+    check_finite_for_png(path, image);
     if (options.png_bits == 16) write_png<std::uint16_t>(path, image);
     else write_png<std::uint8_t>(path, image);
 }

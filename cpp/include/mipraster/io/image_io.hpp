@@ -20,12 +20,13 @@ struct ImageWriteOptions {
 ///    `to_srgb16()`, alpha stored linearly (straight alpha, as PNG defines it). A 3-channel image
 ///    (linear RGB, opaque) is sRGB-encoded the same way and written as RGB. A 1-channel image
 ///    (data such as depth or a mask) is written as plain grey: round(clamp(v, 0, 1) · max code),
-///    with no sRGB encoding and NaN written as 0.
+///    with no sRGB encoding. NaN and ±inf have no code: they are refused (below).
 ///  - `.exr`: 32-bit float, values written exactly as they are (linear; RGBA stays premultiplied,
 ///    as OpenEXR defines it); 1-channel images are stored as channel "Y".
 /// Throws std::invalid_argument for another extension, a malformed image (channels other than 1,
-/// 3 or 4, zero size, pixel count not width·height·channels) or png_bits other than 8 or 16 (or
-/// not 8 for an EXR), and std::runtime_error naming the path and OpenImageIO's message when the
+/// 3 or 4, zero size, pixel count not width·height·channels), png_bits other than 8 or 16 (or
+/// not 8 for an EXR) or a NaN or ±inf value in a PNG (naming the first pixel (x, y) and channel;
+/// nothing is written), and std::runtime_error naming the path and OpenImageIO's message when the
 /// file cannot be opened or written.
 void write_image(const std::string& path, const Image& image, const ImageWriteOptions& options = {});
 
