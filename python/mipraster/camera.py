@@ -68,7 +68,8 @@ class Camera:
             eye, target, up: 3-vectors in world space (``up`` need not be orthogonal to the view
                 direction, only not parallel to it).
             fov_y: vertical field of view in degrees, in (0, 180).
-            near: distance of the near plane, > 0.
+            near: distance of the near plane, at least float32's smallest normal number
+                (about 1.18e-38: the depth buffer holds near / distance in float32).
             far: distance of the far plane, > near; ``inf`` (the default) for an infinite far plane.
 
         The horizontal field of view follows from the render's aspect ratio (width / height).
@@ -148,7 +149,8 @@ class Camera:
                 size, with OpenCV's pixel convention (pixel centres at integer coordinates).
             R: 3×3 world-to-camera rotation.
             t: world-to-camera translation, shape (3,) or (3, 1): x_cam = R @ x_world + t.
-            near, far: depth range along the optical axis, ``0 < near < far`` (``far`` may be inf).
+            near, far: depth range along the optical axis, ``0 < near < far`` (``far`` may be inf;
+                ``near`` at least about 1.18e-38, as for :meth:`look_at`).
 
         OpenCV's camera looks down +z with y down; this maps it to the library's (−z, y up), and
         maps OpenCV pixel coordinates (u, v) to the library's screen position (u + ½, v + ½), so
@@ -247,9 +249,14 @@ class Camera:
 
 
 def _near_far(near: Any, far: Any, *, allow_infinite_far: bool) -> Tuple[float, float]:
+    """A perspective camera's near and far, checked when the camera is made (its projection is
+    built only for a render's size)."""
     n, f = _checks.real(near, "near"), _checks.real(far, "far")
     if not (math.isfinite(n) and n > 0.0):
         raise ValueError(f"near: expected a finite distance > 0, got {n:g}")
     if not (f > n and (math.isfinite(f) or (allow_infinite_far and f == math.inf))):
         raise ValueError(f"far: expected a distance > near ({n:g}) or inf, got {f:g}")
+    # The C++ projection's own checks, e.g. a near too small for float32 depth (ValueError naming
+    # near and the smallest allowed, kMinPerspectiveNear in camera.hpp): one place holds the limit.
+    _core.frustum(-1.0, 1.0, -1.0, 1.0, n, f)
     return n, f

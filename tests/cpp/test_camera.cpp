@@ -8,6 +8,7 @@
 #include <limits>
 #include <random>
 #include <stdexcept>
+#include <string>
 
 #include "helpers.hpp"
 #include "oracle.hpp"
@@ -20,6 +21,16 @@ namespace mr = mipraster;
 glm::dvec3 ndc(const glm::dmat4& projection, const glm::dvec3& p) {
     const auto c = oracle::apply(oracle::from_glm(projection), {p.x, p.y, p.z, 1.0});
     return {c[0] / c[3], c[1] / c[3], c[2] / c[3]};
+}
+
+template <class Fn>
+std::string thrown_message(Fn&& fn) {
+    try {
+        fn();
+    } catch (const std::invalid_argument& e) {
+        return e.what();
+    }
+    return "<nothing thrown>";
 }
 
 glm::dvec3 transform_point(const glm::dmat4& m, const glm::dvec3& p) {
@@ -191,6 +202,24 @@ TEST(Camera, InvalidParametersThrowNamingTheProblem) {
     EXPECT_THROW(mr::perspective(0.0, 1.0, 0.1), std::invalid_argument);
     EXPECT_THROW(mr::perspective(3.2, 1.0, 0.1), std::invalid_argument);
     EXPECT_THROW(mr::perspective(1.0, 0.0, 0.1), std::invalid_argument);
+    // A near plane too small for float32 depth (near / distance rounds to 0, the clear depth): the
+    // message names near and the smallest allowed value, for every perspective constructor.
+    const double too_small = std::nextafter(mr::kMinPerspectiveNear, 0.0);
+    for (const double n : {1e-45, 1e-40, too_small, 1e-320}) {
+        for (const mr::DepthConvention c : {mr::DepthConvention::reverse_z, mr::DepthConvention::opengl}) {
+            const std::string message = thrown_message([&] { mr::frustum(-1, 1, -1, 1, n, 10.0, c); });
+            EXPECT_NE(message.find("near = "), std::string::npos) << message;
+            EXPECT_NE(message.find(">= 1.17549435e-38"), std::string::npos) << message;
+        }
+        EXPECT_THROW(mr::perspective(1.0, 1.0, n), std::invalid_argument) << n;
+        EXPECT_THROW(mr::Camera::look_at_perspective({0, 0, 3}, {0, 0, 0}, {0, 1, 0}, 1.0, 1.0, n),
+                     std::invalid_argument)
+            << n;
+    }
+    EXPECT_EQ(mr::kMinPerspectiveNear, static_cast<double>(std::numeric_limits<float>::min()));
+    EXPECT_NO_THROW(mr::perspective(1.0, 1.0, mr::kMinPerspectiveNear));
+    EXPECT_NO_THROW(mr::perspective(1.0, 1.0, 1e-3));  // the depth contract's near
+    EXPECT_NO_THROW(mr::orthographic(-1, 1, -1, 1, 1e-45, 10.0));  // linear depth: any near
     EXPECT_THROW(mr::orthographic(-1, 1, -1, 1, 1.0, 1.0), std::invalid_argument);
     EXPECT_THROW(mr::orthographic(-1, 1, -1, 1, 1.0, inf), std::invalid_argument);
     EXPECT_THROW(mr::look_at({1, 2, 3}, {1, 2, 3}, {0, 1, 0}), std::invalid_argument);

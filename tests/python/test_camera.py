@@ -258,6 +258,19 @@ def test_orthographic_maps_world_units_linearly():
          ["R", "(3, 3)", "(3,)"]),
         (lambda: mr.Camera.from_opencv(np.eye(3), np.eye(3), np.zeros(4)), ValueError, ["t", "(3,)", "(4,)"]),
         (lambda: mr.Camera.from_opencv(np.eye(3), np.eye(3), np.zeros(3), near=-1), ValueError, ["near"]),
+        # A near below float32's smallest normal number: depth near / distance rounded to 0, the
+        # clear depth, and the image was blank (near=1e-45), or lost precision (near=1e-40).
+        (lambda: mr.Camera.look_at((0, 0, 3), (0, 0, 0), near=1e-45), ValueError,
+         ["near = 1e-45 is too small", ">= 1.17549435e-38"]),
+        (lambda: mr.Camera.look_at((0, 0, 3), (0, 0, 0), near=1e-40), ValueError, ["near", ">= 1.17549435e-38"]),
+        (lambda: mr.Camera.look_at((0, 0, 3), (0, 0, 0), near=1e-300, far=1), ValueError, ["near", "1.17549435e-38"]),
+        (lambda: mr.Camera.from_opencv(np.eye(3), np.eye(3), np.zeros(3), near=1e-45), ValueError,
+         ["near", ">= 1.17549435e-38"]),
+        (lambda: mr._core.perspective(1.0, 1.0, 1e-320), ValueError, ["near", ">= 1.17549435e-38"]),
+        (lambda: mr._core.frustum(-1, 1, -1, 1, 1e-39, 1, mr._core.DepthConvention.opengl), ValueError,
+         ["near", ">= 1.17549435e-38"]),
+        (lambda: mr._core.Camera.look_at_perspective((0, 0, 3), (0, 0, 0), (0, 1, 0), 1.0, 1.0, 1e-45), ValueError,
+         ["near", ">= 1.17549435e-38"]),
     ],
 )
 def test_bad_camera_arguments(make, error, words):
@@ -265,6 +278,21 @@ def test_bad_camera_arguments(make, error, words):
         make()
     for w in words:
         assert w in str(e.value)
+
+
+def test_the_smallest_near_plane_still_draws_and_orders():
+    # The smallest near accepted renders the same triangle as near=0.01 (reverse-Z, depth
+    # near / distance: 3.9e-39 at distance 3, still above 0), and the depth contract's near 1e-3
+    # is accepted (test_depth.cpp checks its ordering).
+    smallest = float(np.finfo(np.float32).tiny)
+    scene = mr.Scene()
+    scene.add(mr.Mesh([[-1, -1, 0], [1, -1, 0], [0, 1, 0]], [[0, 1, 2]]))
+    reference = mr.render(scene, mr.Camera.look_at((0, 0, 3), (0, 0, 0)), 16, 16).color
+    got = mr.render(scene, mr.Camera.look_at((0, 0, 3), (0, 0, 0), near=smallest), 16, 16).color
+    np.testing.assert_array_equal(got, reference)
+    mr.Camera.look_at((0, 0, 3), (0, 0, 0), near=1e-3)
+    # Orthographic depth is linear in distance: any near, 0 and negative included.
+    mr.Camera.orthographic((0, 0, 3), (0, 0, 0), near=1e-45, far=10).build(4, 4)
 
 
 def test_opencv_column_vector_t_is_accepted():

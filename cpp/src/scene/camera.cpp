@@ -1,6 +1,7 @@
 #include "mipraster/scene/camera.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -12,6 +13,13 @@ namespace {
 
 void require(bool ok, const std::string& message) {
     if (!ok) throw std::invalid_argument(message);
+}
+
+// A number for messages, as %.9g (std::to_string printed 1e-45 as 0.000000).
+std::string number(double v) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.9g", v);
+    return buffer;
 }
 
 // Depth rows (third row of the projection, as z_clip = a·z + b·w_view) for each convention.
@@ -60,9 +68,13 @@ glm::dmat4 look_at(const glm::dvec3& eye, const glm::dvec3& target, const glm::d
 }
 
 glm::dmat4 frustum(double l, double r, double b, double t, double n, double f, DepthConvention c) {
+    require(std::isfinite(n) && n > 0.0, "frustum: near must be finite and > 0, got " + number(n));
+    require(n >= kMinPerspectiveNear,
+            "near = " + number(n) + " is too small: expected a near plane >= " + number(kMinPerspectiveNear) +
+                " (float32's smallest normal number: the depth buffer holds near / distance in float32, which "
+                "below it loses precision and rounds to 0, the clear depth, so nothing would be drawn)");
     require(std::isfinite(l) && std::isfinite(r) && std::isfinite(b) && std::isfinite(t) && r != l && t != b,
             "frustum: l, r, b, t must be finite with l != r and b != t");
-    require(std::isfinite(n) && n > 0.0, "frustum: near must be finite and > 0, got " + std::to_string(n));
     require(f > n, "frustum: far must be > near, got far=" + std::to_string(f));
     glm::dmat4 m(0.0);
     m[0][0] = 2.0 * n / (r - l);

@@ -22,8 +22,21 @@ glm::dmat4 look_at(const glm::dvec3& eye, const glm::dvec3& target, const glm::d
 
 inline constexpr double kInfiniteFar = std::numeric_limits<double>::infinity();
 
-/// Perspective projection of the frustum (l, r, b, t) at distance n, far plane at f (may be
-/// kInfiniteFar for reverse-Z). With DepthConvention::opengl this is exactly the seeds' matrix.
+/// The smallest near distance of a perspective projection: float32's smallest normal number,
+/// 2^−126 ≈ 1.18·10⁻³⁸. The depth buffer is float32 and holds near/d for a surface at view
+/// distance d (reverse-Z, infinite far; a finite far gives less): with a near below it the
+/// depth of everything beyond unit distance is subnormal (fewer than float's 24 bits, so
+/// surfaces stop ordering) and at near ≈ 10⁻⁴⁵·d it rounds to 0, the clear depth, which fails
+/// the GREATER test: a blank image (near = 10⁻⁴⁵ at d = 3). From there on near/d is a normal
+/// float up to d = near / 2^−126; the depth contract (distances 10⁻² … 10⁵ at near = 10⁻³,
+/// depths ≥ 10⁻⁸) is far inside. (OpenGL-convention depth, 1 − 2·near/d, loses far more, and
+/// is bounded by the same minimum.) frustum, perspective and look_at_perspective throw
+/// std::invalid_argument below it; orthographic depth is linear in distance and takes any near.
+inline constexpr double kMinPerspectiveNear = static_cast<double>(std::numeric_limits<float>::min());
+
+/// Perspective projection of the frustum (l, r, b, t) at distance n (≥ kMinPerspectiveNear), far
+/// plane at f (may be kInfiniteFar for reverse-Z). With DepthConvention::opengl this is exactly
+/// the seeds' matrix.
 glm::dmat4 frustum(double l, double r, double b, double t, double n, double f,
                    DepthConvention convention = DepthConvention::reverse_z);
 
