@@ -146,16 +146,31 @@ struct UsageError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-int parse_int(const std::string& option, const std::string& text) {
+// Every integer option's bounds unless it names tighter ones: ±2^30 (int, with room to spare).
+constexpr long long kIntOptionLimit = 1LL << 30;
+
+// A whole decimal integer in [lo, hi]: "not an integer" and "out of range" are told apart
+// (99999999999 is an integer, only too large; std::stoll's out_of_range counts as out of range).
+int parse_int(const std::string& option, const std::string& text, long long lo = -kIntOptionLimit,
+              long long hi = kIntOptionLimit) {
     std::size_t used = 0;
-    long value = 0;
+    long long value = 0;
+    bool out_of_range = false;
     try {
-        value = std::stol(text, &used);
+        value = std::stoll(text, &used);
+    } catch (const std::out_of_range&) {  // digits (after an optional sign) beyond long long
+        const std::size_t sign = text[0] == '-' || text[0] == '+';
+        out_of_range = text.size() > sign && std::all_of(text.begin() + sign, text.end(), [](char c) {
+            return std::isdigit(static_cast<unsigned char>(c));
+        });
+        used = out_of_range ? text.size() : 0;
     } catch (const std::exception&) {
         used = 0;
     }
-    if (used != text.size() || text.empty() || value < -(1L << 30) || value > (1L << 30))
-        throw UsageError(option + ": expected an integer, got '" + text + "'");
+    if (used != text.size() || text.empty()) throw UsageError(option + ": expected an integer, got '" + text + "'");
+    if (out_of_range || value < lo || value > hi)
+        throw UsageError(option + ": " + text + " is out of range; expected an integer from " + std::to_string(lo) +
+                         " to " + std::to_string(hi));
     return static_cast<int>(value);
 }
 
@@ -197,6 +212,14 @@ double parse_number(const std::string& option, const std::string& text) {
     }
     if (used != text.size() || text.empty() || !std::isfinite(value))
         throw UsageError(option + ": expected a finite number, got '" + text + "'");
+    return value;
+}
+
+// A comparison threshold (compare's --fail, --hard-fail): a finite number >= 0. Checked here to
+// name the option; CompareSettings::validate would name its field.
+double parse_threshold(const std::string& option, const std::string& text) {
+    const double value = parse_number(option, text);
+    if (!(value >= 0.0)) throw UsageError(option + ": expected a threshold >= 0, got '" + text + "'");
     return value;
 }
 
@@ -322,8 +345,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
         } else if (a == "--memory-limit") {
             set_memory_limit(parse_bytes(a, value()));
         } else if (a == "--camera") {
-            o.camera = parse_int(a, value());
-            if (o.camera < 0) throw UsageError("--camera: expected a camera index >= 0, got " + args[i]);
+            o.camera = parse_int(a, value(), 0);  // a camera index
         } else if (a == "--look-at") {
             o.look_at = parse_numbers(a, value(), 6);
         } else if (a == "--fov") {
@@ -361,9 +383,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
         } else if (a == "--error-map") {
             o.error_map = value();
         } else if (a == "--probe-pixels") {
-            o.probe_pixels = parse_int(a, value());
-            if (o.probe_pixels < 0)
-                throw UsageError("--probe-pixels: expected 0 (no probe) or a number of pixels, got " + args[i]);
+            o.probe_pixels = parse_int(a, value(), 0);  // 0: no probe
         } else if (a == "--quiet") {
             o.quiet = true;
         } else if (a == "--bits") {
@@ -597,9 +617,12 @@ int run_compare(const std::vector<std::string>& args) {
             if (i + 1 >= args.size()) throw UsageError(a + ": missing value");
             return args[++i];
         };
-        if (a == "--fail") settings.fail_threshold = parse_number(a, value());
-        else if (a == "--fail-fraction") settings.fail_fraction = parse_number(a, value());
-        else if (a == "--hard-fail") settings.hard_fail_threshold = parse_number(a, value());
+        if (a == "--fail") settings.fail_threshold = parse_threshold(a, value());
+        else if (a == "--fail-fraction") {
+            settings.fail_fraction = parse_number(a, value());
+            if (!(settings.fail_fraction >= 0.0 && settings.fail_fraction <= 1.0))
+                throw UsageError("--fail-fraction: expected a fraction in [0, 1], got '" + args[i] + "'");
+        } else if (a == "--hard-fail") settings.hard_fail_threshold = parse_threshold(a, value());
         else if (!a.empty() && a[0] == '-') throw UsageError("compare: unknown option '" + a + "'");
         else paths.push_back(a);
     }

@@ -110,6 +110,15 @@ def test_exr_output_is_openexr(tmp_path):
         (["--seed", "-1"], ["--seed", "from 0 to 18446744073709551615", "'-1'"]),  # (was taken as 2^64 - 1)
         (["--seed", "18446744073709551616"], ["--seed", "'18446744073709551616'"]),
         (["--bits", "12"], ["--bits", "8 or 16", "'12'"]),
+        # An integer out of range was called "expected an integer": say so and give the range.
+        (["--probe-pixels", "99999999999"], ["--probe-pixels: 99999999999 is out of range",
+                                             "from 0 to 1073741824"]),
+        (["--probe-pixels", "-1"], ["--probe-pixels: -1 is out of range", "from 0 to 1073741824"]),
+        (["--spp", "-99999999999999999999999"], ["--spp: -99999999999999999999999 is out of range",
+                                                 "from -1073741824 to 1073741824"]),
+        (["--camera", "-1"], ["--camera: -1 is out of range", "from 0"]),
+        (["--threads", "4x"], ["--threads: expected an integer, got '4x'"]),
+        (["--size", "99999999999x10"], ["--size width: 99999999999 is out of range"]),
     ],
 )
 def test_bad_options_exit_2_naming_the_input(tmp_path, args, words):
@@ -233,8 +242,10 @@ def test_compare_passes_identical_images_and_fails_different_ones(tmp_path):
     [
         (["missing.png"], ["missing.png"]),
         ([], ["two image paths"]),
-        (["--fail", "-1", "X"], ["fail_threshold"]),
-        (["--fail-fraction", "2", "X"], ["fail_fraction"]),
+        # The options are named (the messages said CompareSettings::fail_threshold etc.)
+        (["--fail", "-1", "X"], ["--fail: expected a threshold >= 0, got '-1'"]),
+        (["--hard-fail", "-0.5", "X"], ["--hard-fail: expected a threshold >= 0, got '-0.5'"]),
+        (["--fail-fraction", "2", "X"], ["--fail-fraction: expected a fraction in [0, 1], got '2'"]),
         (["--bogus", "X"], ["--bogus"]),
     ],
 )
