@@ -85,14 +85,21 @@ def empty_rows(a: np.ndarray, columns: int) -> np.ndarray:
     return a.reshape(0, columns) if a.ndim == 1 and a.size == 0 else a
 
 
-def check_finite(a: np.ndarray, name: str) -> None:
-    """ValueError naming the first NaN or infinite element (row and column for 2-D arrays)."""
+def first_nonfinite(a: np.ndarray) -> Optional[Tuple[int, ...]]:
+    """The index of the first NaN or infinite element of a float array, else None."""
     if a.dtype.kind != "f":
-        return
+        return None
     bad = ~np.isfinite(a)
     if not bad.any():
+        return None
+    return tuple(int(i) for i in np.argwhere(bad)[0])
+
+
+def check_finite(a: np.ndarray, name: str) -> None:
+    """ValueError naming the first NaN or infinite element (row and column for 2-D arrays)."""
+    index = first_nonfinite(a)
+    if index is None:
         return
-    index = tuple(int(i) for i in np.argwhere(bad)[0])
     where = f"{name}[{', '.join(map(str, index))}]"
     if len(index) == 2:
         where += f" (row {index[0]}, column {index[1]})"

@@ -64,12 +64,9 @@ def _check_finite_pixels(a: np.ndarray, what: str) -> None:
     """ValueError naming the first NaN or ±inf value of an (H, W[, C]) image by pixel (x, y) and
     channel: an 8- or 16-bit code has no value for it (it became 0 or the clamp limit, a silent
     wrong image). ``what`` starts the message."""
-    if a.dtype.kind != "f":
+    index = _checks.first_nonfinite(a)
+    if index is None:
         return
-    bad = ~np.isfinite(a)
-    if not bad.any():
-        return
-    index = tuple(int(i) for i in np.argwhere(bad)[0])
     y, x, c = index if len(index) == 3 else (*index, 0)
     raise ValueError(f"{what}: pixel (x={x}, y={y}) channel {c} is {a[index]} (image[{', '.join(map(str, index))}]); "
                      "8- and 16-bit codes need finite values (write .exr to keep NaN and inf)")
@@ -168,9 +165,8 @@ def linear_to_srgb8(linear: Any) -> Any:
     """Linear values to sRGB8 codes (0…255, rounded); TypeError for anything but real numbers,
     ValueError naming the first NaN or ±inf (a code has no value for it)."""
     a = _checks.real_array(linear, "linear")
-    if a.dtype.kind == "f" and not np.isfinite(a).all():
-        if a.ndim == 0:
-            raise ValueError(f"linear is {a.item()}; an sRGB8 code needs a finite number")
-        index = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
-        raise ValueError(f"linear[{', '.join(map(str, index))}] is {a[index]}; an sRGB8 code needs a finite number")
+    index = _checks.first_nonfinite(a)
+    if index is not None:
+        where = f"linear[{', '.join(map(str, index))}]" if index else "linear"
+        raise ValueError(f"{where} is {a[index]}; an sRGB8 code needs a finite number")
     return _core.linear_to_srgb8(a)
