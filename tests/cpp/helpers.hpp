@@ -6,6 +6,7 @@
 #include <cstring>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 #include <random>
 #include <sstream>
 #include <string>
@@ -232,6 +233,17 @@ inline mr::Texture checker_texture(int n = 16, int m = 16) {
             texels.insert(texels.end(), {v, 0.5f * v + 0.2f * float(x) / n, 1.0f - v, 1.0f});
         }
     return mr::Texture::from_float(texels.data(), n, m, 4, true, "checker");
+}
+
+/// What fn throws (any std::exception's message), or "<nothing thrown>".
+template <class Fn>
+std::string thrown_message(Fn&& fn) {
+    try {
+        fn();
+    } catch (const std::exception& e) {
+        return e.what();
+    }
+    return "<nothing thrown>";
 }
 
 }  // namespace helpers

@@ -16,21 +16,12 @@
 namespace {
 
 namespace mr = mipraster;
+using helpers::thrown_message;
 
 /// The projected NDC point (x, y, z) of a view-space point (own matrix code).
 glm::dvec3 ndc(const glm::dmat4& projection, const glm::dvec3& p) {
     const auto c = oracle::apply(oracle::from_glm(projection), {p.x, p.y, p.z, 1.0});
     return {c[0] / c[3], c[1] / c[3], c[2] / c[3]};
-}
-
-template <class Fn>
-std::string thrown_message(Fn&& fn) {
-    try {
-        fn();
-    } catch (const std::invalid_argument& e) {
-        return e.what();
-    }
-    return "<nothing thrown>";
 }
 
 glm::dvec3 transform_point(const glm::dmat4& m, const glm::dvec3& p) {

@@ -18,11 +18,13 @@
 
 #include "mipraster/core/colour.hpp"
 #include "mipraster/core/image.hpp"
+#include "helpers.hpp"
 #include "mipraster/io/image_io.hpp"
 #include "test_output.hpp"
 
 namespace fs = std::filesystem;
 namespace mr = mipraster;
+using helpers::thrown_message;
 
 namespace {
 
@@ -64,16 +66,6 @@ mr::Image sample_rgba() {
     for (int c = 0; c < 3; ++c) img.at(0, 0, c) = 0.5f;
     img.at(0, 0, 3) = 1.0f;
     return img;
-}
-
-template <class Fn>
-std::string thrown_message(Fn&& fn) {
-    try {
-        fn();
-    } catch (const std::exception& e) {
-        return e.what();
-    }
-    return "<nothing thrown>";
 }
 
 }  // namespace
